@@ -1,0 +1,12 @@
+// Built against an installed hqp_wbc by tests/generator/install_smoke.cmake.
+#include <cstdio>
+
+#include "my_robot_model.hpp"
+
+static_assert(my_robot::Robot::nv == 7, "fused_pair.urdf: free base + one joint");
+static_assert(my_robot::Robot::Frames::tip == 2, "FRAMES tip: bodies first, then tip");
+
+int main() {
+  std::printf("nv=%d nframes=%d\n", my_robot::Robot::nv, my_robot::Robot::nframes);
+  return 0;
+}
