@@ -1,0 +1,912 @@
+#pragma once
+// Dense primal active-set solver for least-squares QPs (the per-level QP of the
+// hierarchy, paper Sec. IV-A, eqs. 3–4):
+//   min_x ½‖A x − b‖²   s.t.   E x = e,   lower ≤ C x ≤ upper.
+// The Hessian AᵀA is only positive SEMI-definite (rank-deficient A is the normal
+// case in the lower levels), so the method never forms or inverts it:
+//  - the working set K = [E_indep; C_W] is kept as an incrementally updated QR
+//    factorization Kᵀ = Q [R; 0] (Givens rotations on add / remove), Z = Q(:, k:)
+//    spans its null space, and A Q is updated with the same rotations;
+//  - the subproblem optimum on the working set is x* = x_p + Z (A Z)⁺ (b − A x_p)
+//    with x_p the minimum-norm point of K x = rhs; (A Z)⁺ by a complete orthogonal
+//    decomposition, so the step is defined for any rank and x* is the minimum-norm
+//    minimizer on the working set;
+//  - multipliers by Kᵀ λ = −Aᵀ(A x − b) through the same QR;
+//  - phase 1 is the same method on min ½t² s.t. lower − t ≤ Ĉ x ≤ upper + t, E x = e
+//    (Ĉ: rows scaled to unit norm).
+// Method, sign conventions, complexity and iteration bound: docs/active-set-qp.md.
+// Real-time: no heap (compile-time max sizes), no exceptions, no virtual calls,
+// every loop bounded by the sizes or by QpSettings::max_iterations.
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <Eigen/Jacobi>
+
+#include <cmath>
+#include <limits>
+
+#include "hqp/detail/qp_min_norm_ls.hpp"
+#include "hqp/qp_settings.hpp"
+#include "hqp/qp_status.hpp"
+
+namespace hqp {
+
+namespace detail {
+// √(a² + b²) for Givens rotations; the data are row-scaled, so the overflow guard
+// of std::hypot (slow) is not needed.
+inline double hyp(double a, double b) { return std::sqrt(a * a + b * b); }
+}  // namespace detail
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+class ActiveSetQp {
+  static_assert(MaxN > 0 && MaxRows >= 0 && MaxEq >= 0 && MaxIneq >= 0, "sizes");
+  static constexpr int NV = MaxN + 1;                  // variables incl. phase-1 t
+  static constexpr int MR = MaxRows > 0 ? MaxRows : 1;  // objective rows (phase 1 uses 1)
+  static constexpr int ME = MaxEq > 0 ? MaxEq : 1;
+  static constexpr int MI = MaxIneq > 0 ? MaxIneq : 1;
+
+ public:
+  // Eigen requires row-major storage for a matrix of at most one row.
+  static constexpr int storage(int max_rows) {
+    return max_rows == 1 && MaxN != 1 ? Eigen::RowMajor : Eigen::ColMajor;
+  }
+
+ public:
+  using MatrixA =
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, storage(MaxRows), MaxRows, MaxN>;
+  using MatrixE =
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, storage(MaxEq), MaxEq, MaxN>;
+  using MatrixC =
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, storage(MaxIneq), MaxIneq, MaxN>;
+  using VectorX = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, MaxN, 1>;
+  using VectorRows = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, MaxRows, 1>;
+  using VectorEq = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, MaxEq, 1>;
+  using VectorIneq = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, MaxIneq, 1>;
+
+  explicit ActiveSetQp(const QpSettings& settings = {}) : settings_(settings) {
+    resize(0, 0, 0, 0);
+  }
+
+  // Sets the sizes. Keeps the working set (warm start) if the sizes are unchanged.
+  void resize(int n, int m, int me, int mi) {
+    if (n == n_ && m == m_ && me == me_ && mi == mi_) return;
+    // Blocks whose size is unchanged keep their data.
+    if (n != n_ || m != m_) {
+      A_.setZero(m, n);
+      b_.setZero(m);
+    }
+    if (n != n_ || me != me_) {
+      E_.setZero(me, n);
+      e_.setZero(me);
+    }
+    if (n != n_ || mi != mi_) {
+      C_.setZero(mi, n);
+      lower_.setConstant(mi, -kInf);
+      upper_.setConstant(mi, kInf);
+    }
+    n_ = n;
+    m_ = m;
+    me_ = me;
+    mi_ = mi;
+    x_.setZero(n);
+    lam_eq_.setZero(me);
+    resetWorkingSet();
+  }
+
+  MatrixA& A() { return A_; }
+  VectorRows& b() { return b_; }
+  MatrixE& E() { return E_; }
+  VectorEq& e() { return e_; }
+  MatrixC& C() { return C_; }
+  VectorIneq& lower() { return lower_; }
+  VectorIneq& upper() { return upper_; }
+  const MatrixA& A() const { return A_; }
+  const VectorRows& b() const { return b_; }
+  const MatrixE& E() const { return E_; }
+  const VectorEq& e() const { return e_; }
+  const MatrixC& C() const { return C_; }
+  const VectorIneq& lower() const { return lower_; }
+  const VectorIneq& upper() const { return upper_; }
+  QpSettings& settings() { return settings_; }
+
+  // Hessian form ½xᵀHx + gᵀx → least squares with AᵀA = H, Aᵀb = −g (eigen-
+  // decomposition; the objectives differ by a constant). Set-up only: allocates.
+  // Returns false if H is not PSD, rank(H) > MaxRows, or g ∉ range(H) (unbounded).
+  // Call resize(n, ·, me, mi) first; this sets m = rank(H) and keeps E, C.
+  bool setHessianForm(const Eigen::Ref<const Eigen::MatrixXd>& H,
+                      const Eigen::Ref<const Eigen::VectorXd>& g);
+
+  QpStatus solve(bool warm_start = true) noexcept { return solveImpl(nullptr, warm_start); }
+  // x_init: a point believed feasible (e.g. 0 in the reduced space of the HQP);
+  // used as the phase-2 start if it is feasible, ignored otherwise.
+  QpStatus solve(const VectorX& x_init, bool warm_start) noexcept {
+    return solveImpl(&x_init, warm_start);
+  }
+
+  const VectorX& x() const { return x_; }
+  double objective() const { return objective_; }  // ½‖A x − b‖²
+  int iterations() const { return iterations_; }
+  QpStatus status() const { return status_; }
+
+  // Active inequality rows at the solution (the working set).
+  int numActive() const { return nw_; }
+  int activeRow(int k) const { return ws_row_(k); }
+  bool activeAtUpper(int k) const { return ws_upper_(k) != 0; }
+  // μ_k ≥ 0 with  Aᵀ(Ax − b) + Eᵀλ + Σ_upper μ_k c_k − Σ_lower μ_k c_k = 0.
+  double multiplier(int k) const { return ws_mu_(k); }
+  const VectorEq& equalityMultipliers() const { return lam_eq_; }  // λ above
+  void resetWorkingSet() {
+    nw_ = 0;
+    have_ws_ = false;
+  }
+
+ private:
+  static constexpr double kInf = std::numeric_limits<double>::infinity();
+  // Working-set changes after which the two-sided structure pays for itself.
+  static constexpr int kEstablishAfter = 2;
+  using MatNN = Eigen::Matrix<double, NV, NV>;
+  using VecN = Eigen::Matrix<double, NV, 1>;
+
+  QpStatus solveImpl(const VectorX* x_init, bool warm_start) noexcept;
+  void finish(QpStatus s);
+  bool prepare();                      // scaled copies, input checks
+  void startPhase(bool phase1);        // K = E rows only, objective of the phase
+  bool addEqualities();                // returns false if E x = e is inconsistent
+  bool addRow(int j, bool upper);      // adds C row j (side) to K; false if dependent
+  bool addRowVector(double rhs);       // adds a_ (length nv_) to K
+  void removeRow(int pos);             // removes K row pos (pos ≥ neq_)
+  bool subproblem();                   // xs_ = optimum on the working set
+  bool multipliers();                  // lam_ for K at x = xs_ (needs y_ from subproblem())
+  QpStatus iterate(bool phase1);       // the active-set loop on the current phase
+  double maxViolation(const VecN& v);  // scaled, over E and C (uses ev_, cx_)
+  void givens(int p, double c, double s);    // Q, G columns p, p+1
+  // Two-sided structure of G_Z = Uᵀ A Z = [T 0; 0 0], T upper triangular
+  // (r = min(m, nz)): see docs/active-set-qp.md, "Incremental factorizations".
+  void colRot(int i, int j, double c, double s);  // Q, G columns i, j
+  // G rows i, j and c̃; Z columns before local index zfrom are zero in both rows.
+  void rowRot(int i, int j, double c, double s, int zfrom = 0);
+  void establishStructure();                      // G_Z → [T 0; 0 0]
+  void addRowStructured(double rhs);               // after the independence test
+  void restoreAfterRemove();                       // new first Z column
+
+  QpSettings settings_;
+  int n_ = -1, m_ = -1, me_ = -1, mi_ = -1;
+  MatrixA A_;
+  VectorRows b_;
+  MatrixE E_;
+  VectorEq e_;
+  MatrixC C_;
+  VectorIneq lower_, upper_;
+
+  // Scaled rows (unit norm; zero rows kept as zero).
+  Eigen::Matrix<double, MI, MaxN> Cs_;
+  Eigen::Matrix<double, MI, 1> ls_, us_, cinv_;
+  Eigen::Matrix<double, ME, MaxN> Es_;
+  Eigen::Matrix<double, ME, 1> es_, einv_, ev_;
+  Eigen::Matrix<int, ME, 1> eq_indep_;  // 1 if E row is in K
+  double scale_a_ = 1.0;                // ‖A‖_F, for the absolute rank cut of A Z
+
+  // Current phase.
+  int nv_ = 0;     // variables: n (phase 2) or n + 1 (phase 1)
+  int mc_ = 0;     // objective rows
+  Eigen::Matrix<double, MR, NV> Acur_;
+  Eigen::Matrix<double, MR, 1> bcur_;
+
+  // Working set K (k_ rows: neq_ equalities, then nw_ inequalities).
+  int k_ = 0, neq_ = 0, nw_ = 0;
+  bool have_ws_ = false;
+  bool xs_fresh_ = false;  // xs_ is the subproblem optimum of the current K
+  Eigen::Matrix<int, NV, 1> eq_pos_;     // E row of K row i < neq_
+  Eigen::Matrix<int, NV, 1> ws_row_;     // C row of K row neq_ + i
+  Eigen::Matrix<int, NV, 1> ws_upper_;   // side
+  Eigen::Matrix<double, NV, 1> ws_mu_;   // reported multipliers (unscaled, ≥ 0)
+  Eigen::Matrix<int, NV, 1> ws_prev_row_, ws_prev_upper_;  // warm-start copy
+  Eigen::Matrix<int, MI, 1> in_ws_;
+  Eigen::Matrix<double, NV, 1> rhs_;
+  MatNN Q_, R_;
+  Eigen::Matrix<double, MR, NV, Eigen::RowMajor> AQ_;  // G = Uᵀ A Q (U: row rotations, in structured mode)
+  Eigen::Matrix<double, MR, 1> cU_;       // c̃ = Uᵀ b
+  bool trap_ = false;                     // G_Z has the [T 0; 0 0] structure
+  int changes_ = 0;                       // working-set changes in this phase
+  Eigen::Matrix<double, (MR > NV ? MR : NV), 1> hv_;  // reflector scratch
+  Eigen::Matrix<double, MR, NV> M_;       // A Z scratch
+  Eigen::Matrix<double, MR, 1> r_;        // residual scratch
+  VecN a_, w_, xs_, xc_, d_, y_, p_, lam_;
+  Eigen::Matrix<double, (MR > NV ? MR : NV), 1> work_;  // Householder workspace
+  Eigen::Matrix<double, MI, 1> cd_, cx_;  // Ĉ d, Ĉ x (ratio test)
+  detail::QpMinNormWorkspace<MR, NV> cod_;
+
+  VectorX x_;
+  VectorEq lam_eq_;
+  double objective_ = 0.0;
+  int iterations_ = 0;
+  QpStatus status_ = QpStatus::Optimal;
+};
+
+// ---------------------------------------------------------------------------
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::setHessianForm(
+    const Eigen::Ref<const Eigen::MatrixXd>& H, const Eigen::Ref<const Eigen::VectorXd>& g) {
+  const int n = static_cast<int>(H.rows());
+  if (H.cols() != n || g.size() != n || n > MaxN || n <= 0) return false;
+  if (!H.allFinite() || !g.allFinite()) return false;
+  const Eigen::MatrixXd Hs = 0.5 * (H + H.transpose());
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Hs);
+  if (eig.info() != Eigen::Success) return false;
+  const Eigen::VectorXd& lam = eig.eigenvalues();
+  const Eigen::MatrixXd& V = eig.eigenvectors();
+  const double lmax = lam.cwiseAbs().maxCoeff();
+  const double tol = 1e-12 * (lmax > 0.0 ? lmax : 1.0);
+  int rank = 0;
+  for (int i = 0; i < n; ++i) {
+    if (lam(i) < -tol) return false;  // not PSD
+    if (lam(i) > tol) ++rank;
+  }
+  if (rank > MaxRows) return false;
+  const Eigen::VectorXd vg = V.transpose() * g;
+  for (int i = 0; i < n; ++i)  // g must lie in range(H), else unbounded below
+    if (lam(i) <= tol && std::abs(vg(i)) > 1e-9 * (1.0 + g.norm())) return false;
+  resize(n, rank, me_ < 0 ? 0 : me_, mi_ < 0 ? 0 : mi_);
+  int row = 0;
+  for (int i = 0; i < n; ++i) {
+    if (lam(i) <= tol) continue;
+    const double sq = std::sqrt(lam(i));
+    A_.row(row) = sq * V.col(i).transpose();  // A = D^½ Vᵀ  ⇒ AᵀA = H
+    b_(row) = -vg(i) / sq;                    // Aᵀb = −g
+    ++row;
+  }
+  return true;
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::givens(int p, double c, double s) {
+  // Q ← Q Gᵀ on columns p, p+1 (and A Q likewise).
+  Eigen::JacobiRotation<double> g(c, -s);
+  Q_.block(0, p, nv_, 2).applyOnTheRight(0, 1, g);
+  if (mc_ > 0) AQ_.block(0, p, mc_, 2).applyOnTheRight(0, 1, g);
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addRowVector(double rhs) {
+  if (k_ >= nv_) return false;
+  // w = Qᵀ a; the row is independent of K iff w(k:) = Zᵀ a ≠ 0.
+  const int nz = nv_ - k_;
+  w_.head(nv_).noalias() = Q_.topLeftCorner(nv_, nv_).transpose() * a_.head(nv_);
+  const double an2 = a_.head(nv_).squaredNorm();
+  const double wn2 = w_.segment(k_, nz).squaredNorm();
+  const double tol = settings_.rank_tol;
+  if (!(wn2 > tol * tol * an2) || an2 == 0.0) return false;
+  if (trap_) {
+    addRowStructured(rhs);
+    return true;
+  }
+  // One reflector H with H w(k:) = β e₀, applied to the Z columns of Q and G.
+  double tau = 0.0, beta = 0.0;
+  w_.segment(k_, nz).makeHouseholderInPlace(tau, beta);
+  if (nz > 1) {
+    Q_.block(0, k_, nv_, nz)
+        .applyHouseholderOnTheRight(w_.segment(k_ + 1, nz - 1), tau, work_.data());
+    if (mc_ > 0)
+      AQ_.block(0, k_, mc_, nz)
+          .applyHouseholderOnTheRight(w_.segment(k_ + 1, nz - 1), tau, work_.data());
+  } else {
+    beta = w_(k_);
+  }
+  R_.col(k_).head(k_) = w_.head(k_);
+  R_(k_, k_) = beta;
+  R_.col(k_).segment(k_ + 1, nv_ - k_ - 1).setZero();
+  rhs_(k_) = rhs;
+  ++k_;
+  return true;
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::colRot(int i, int j, double c, double s) {
+  // col_i ← c col_i + s col_j,  col_j ← −s col_i + c col_j
+  const Eigen::JacobiRotation<double> g(c, -s);
+  Q_.topLeftCorner(nv_, nv_).applyOnTheRight(i, j, g);
+  if (mc_ > 0) AQ_.topLeftCorner(mc_, nv_).applyOnTheRight(i, j, g);
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::rowRot(int i, int j, double c, double s,
+                                                        int zfrom) {
+  // row_i ← c row_i + s row_j,  row_j ← −s row_i + c row_j  (U ← U Gᵀ); G is
+  // row-major, so both segments are contiguous.
+  double* gi = &AQ_(i, 0);
+  double* gj = &AQ_(j, 0);
+  for (int l = 0; l < k_; ++l) {
+    const double a = gi[l], b = gj[l];
+    gi[l] = c * a + s * b;
+    gj[l] = -s * a + c * b;
+  }
+  for (int l = k_ + zfrom; l < nv_; ++l) {
+    const double a = gi[l], b = gj[l];
+    gi[l] = c * a + s * b;
+    gj[l] = -s * a + c * b;
+  }
+  const double ci = cU_(i), cj = cU_(j);
+  cU_(i) = c * ci + s * cj;
+  cU_(j) = -s * ci + c * cj;
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::establishStructure() {
+  // Bring G_Z = G(:, k:) to [T 0; 0 0] once; afterwards every working-set change
+  // keeps it with O((n + m)(nz + m)) rotations.
+  const int nz = nv_ - k_;
+  trap_ = true;
+  if (mc_ == 0 || nz == 0) return;
+  if (nz > mc_) {
+    // Wide: reflectors from the right, row by row: G_Z = [L 0], L lower triangular.
+    for (int i = 0; i < mc_; ++i) {
+      const int len = nz - i;
+      hv_.head(len) = AQ_.row(i).segment(k_ + i, len).transpose();
+      double tau = 0.0, beta = 0.0;
+      hv_.head(len).makeHouseholderInPlace(tau, beta);
+      if (len > 1) {
+        AQ_.block(i, k_ + i, mc_ - i, len)
+            .applyHouseholderOnTheRight(hv_.segment(1, len - 1), tau, work_.data());
+        Q_.block(0, k_ + i, nv_, len)
+            .applyHouseholderOnTheRight(hv_.segment(1, len - 1), tau, work_.data());
+      }
+      AQ_.row(i).segment(k_ + i + 1, len - 1).setZero();  // exact zeros
+    }
+  }
+  // Reflectors from the left (QR of the first r columns of G_Z): T upper triangular.
+  const int r = nz < mc_ ? nz : mc_;
+  for (int i = 0; i < r; ++i) {
+    const int len = mc_ - i;
+    if (len <= 1) break;
+    hv_.head(len) = AQ_.col(k_ + i).segment(i, len);
+    double tau = 0.0, beta = 0.0;
+    hv_.head(len).makeHouseholderInPlace(tau, beta);
+    AQ_.block(i, 0, len, nv_)
+        .applyHouseholderOnTheLeft(hv_.segment(1, len - 1), tau, work_.data());
+    cU_.segment(i, len).applyHouseholderOnTheLeft(hv_.segment(1, len - 1), tau, work_.data());
+    AQ_.col(k_ + i).segment(i + 1, len - 1).setZero();
+  }
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addRowStructured(double rhs) {
+  // Givens bottom-up on w(k:) (w_ = Qᵀ a is set): each column rotation (j−1, j) of
+  // G_Z makes one subdiagonal fill (j, j−1), removed at once by a row rotation.
+  const int nz = nv_ - k_;
+  const int r = nz < mc_ ? nz : mc_;
+  int top = nv_ - 1;
+  if (nz - r > 1) {
+    // Z columns r.. are zero in G: one reflector on Q alone clears w(k+r+1:).
+    const int len = nz - r;
+    double tau = 0.0, beta = 0.0;
+    w_.segment(k_ + r, len).makeHouseholderInPlace(tau, beta);
+    Q_.block(0, k_ + r, nv_, len)
+        .applyHouseholderOnTheRight(w_.segment(k_ + r + 1, len - 1), tau, work_.data());
+    w_(k_ + r) = beta;
+    w_.segment(k_ + r + 1, len - 1).setZero();
+    top = k_ + r;
+  }
+  for (int i = top; i > k_; --i) {
+    const double wp = w_(i - 1), wq = w_(i);
+    if (wq == 0.0) continue;
+    const double rho = detail::hyp(wp, wq);
+    const double c = wp / rho, s = wq / rho;
+    w_(i - 1) = rho;
+    w_(i) = 0.0;
+    const int jl = i - k_;  // local index of column i in Z
+    if (jl - 1 >= r) {      // both columns of G_Z are zero: only Q turns
+      const Eigen::JacobiRotation<double> g(c, -s);
+      Q_.topLeftCorner(nv_, nv_).applyOnTheRight(i - 1, i, g);
+      continue;
+    }
+    colRot(i - 1, i, c, s);
+    if (jl < mc_) {
+      const double a = AQ_(jl - 1, i - 1), b = AQ_(jl, i - 1);
+      if (b != 0.0) {
+        const double rr = detail::hyp(a, b);
+        rowRot(jl - 1, jl, a / rr, b / rr, jl - 1);
+        AQ_(jl, i - 1) = 0.0;
+      }
+    }
+  }
+  for (int i = 0; i <= k_; ++i) R_(i, k_) = w_(i);
+  R_.col(k_).segment(k_ + 1, nv_ - k_ - 1).setZero();
+  rhs_(k_) = rhs;
+  ++k_;
+  // The old first Z column left: G_Z is upper Hessenberg; row rotations restore T.
+  const int nz2 = nz - 1;
+  for (int j = 0; j < nz2 && j + 1 < mc_; ++j) {
+    const double a = AQ_(j, k_ + j), b = AQ_(j + 1, k_ + j);
+    if (b == 0.0) continue;
+    const double rr = detail::hyp(a, b);
+    rowRot(j, j + 1, a / rr, b / rr, j);
+    AQ_(j + 1, k_ + j) = 0.0;
+  }
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::restoreAfterRemove() {
+  // G_Z = [g, T, 0]: zero g below its first entry with row rotations (bottom-up);
+  // in the wide case this leaves one extra column (index m), cleared against the
+  // diagonal with column rotations.
+  if (mc_ == 0) return;
+  const int nz = nv_ - k_;  // includes the new column
+  for (int i = mc_ - 1; i >= 1; --i) {
+    const double a = AQ_(i - 1, k_), b = AQ_(i, k_);
+    if (b == 0.0) continue;
+    const double rr = detail::hyp(a, b);
+    rowRot(i - 1, i, a / rr, b / rr);
+    AQ_(i, k_) = 0.0;
+  }
+  if (nz > mc_) {
+    const int e = k_ + mc_;  // the extra column
+    for (int i = mc_ - 1; i >= 0; --i) {
+      const double a = AQ_(i, k_ + i), b = AQ_(i, e);
+      if (b == 0.0) continue;
+      const double rr = detail::hyp(a, b);
+      colRot(k_ + i, e, a / rr, b / rr);
+      AQ_(i, e) = 0.0;
+    }
+  }
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::removeRow(int pos) {
+  // Delete column pos of R, then restore the triangle (Hessenberg → Givens).
+  for (int j = pos; j < k_ - 1; ++j) {
+    for (int i = 0; i <= j + 1; ++i) R_(i, j) = R_(i, j + 1);
+    rhs_(j) = rhs_(j + 1);
+  }
+  for (int j = pos; j < k_ - 1; ++j) {
+    const double a = R_(j, j), b = R_(j + 1, j);
+    if (b == 0.0) continue;
+    const double rho = detail::hyp(a, b);
+    const double c = a / rho, s = b / rho;
+    for (int l = j; l < k_ - 1; ++l) {
+      const double rj = R_(j, l), rq = R_(j + 1, l);
+      R_(j, l) = c * rj + s * rq;
+      R_(j + 1, l) = -s * rj + c * rq;
+    }
+    R_(j + 1, j) = 0.0;
+    givens(j, c, s);
+  }
+  --k_;
+  for (int i = 0; i < nv_; ++i) R_(i, k_) = 0.0;
+  if (trap_) restoreAfterRemove();
+  // Keep the inequality bookkeeping in K order.
+  const int w = pos - neq_;
+  in_ws_(ws_row_(w)) = 0;
+  for (int i = w; i < nw_ - 1; ++i) {
+    ws_row_(i) = ws_row_(i + 1);
+    ws_upper_(i) = ws_upper_(i + 1);
+  }
+  --nw_;
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addRow(int j, bool upper) {
+  for (int i = 0; i < n_; ++i) a_(i) = Cs_(j, i);
+  if (nv_ > n_) a_(n_) = upper ? -1.0 : 1.0;
+  if (!addRowVector(upper ? us_(j) : ls_(j))) return false;
+  ws_row_(nw_) = j;
+  ws_upper_(nw_) = upper ? 1 : 0;
+  in_ws_(j) = 1;
+  ++nw_;
+  return true;
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::prepare() {
+  // Rows scaled to unit norm (zero rows stay zero); non-finite data is rejected
+  // (±inf bounds are allowed, NaN bounds are not).
+  if (n_ <= 0) return true;
+  if (!A_.allFinite() || !b_.allFinite() || !E_.allFinite() || !e_.allFinite() ||
+      !C_.allFinite())
+    return false;
+  if (mi_ > 0) {
+    if (lower_.hasNaN() || upper_.hasNaN()) return false;
+    cinv_.head(mi_) = C_.rowwise().norm();
+    for (int j = 0; j < mi_; ++j) cinv_(j) = cinv_(j) > 0.0 ? 1.0 / cinv_(j) : 1.0;
+    Cs_.topLeftCorner(mi_, n_) = cinv_.head(mi_).asDiagonal() * C_;
+    ls_.head(mi_) = lower_.cwiseProduct(cinv_.head(mi_));
+    us_.head(mi_) = upper_.cwiseProduct(cinv_.head(mi_));
+    in_ws_.head(mi_).setZero();
+  }
+  if (me_ > 0) {
+    einv_.head(me_) = E_.rowwise().norm();
+    for (int i = 0; i < me_; ++i) einv_(i) = einv_(i) > 0.0 ? 1.0 / einv_(i) : 1.0;
+    Es_.topLeftCorner(me_, n_) = einv_.head(me_).asDiagonal() * E_;
+    es_.head(me_) = e_.cwiseProduct(einv_.head(me_));
+  }
+  scale_a_ = m_ > 0 ? A_.norm() : 0.0;
+  return true;
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::startPhase(bool phase1) {
+  nv_ = phase1 ? n_ + 1 : n_;
+  if (phase1) {
+    mc_ = 1;  // ½t²
+    for (int i = 0; i < nv_; ++i) Acur_(0, i) = 0.0;
+    Acur_(0, n_) = 1.0;
+    bcur_(0) = 0.0;
+  } else {
+    mc_ = m_;
+    for (int i = 0; i < m_; ++i) {
+      for (int c = 0; c < n_; ++c) Acur_(i, c) = A_(i, c);
+      bcur_(i) = b_(i);
+    }
+  }
+  for (int c = 0; c < nv_; ++c) {
+    for (int r = 0; r < nv_; ++r) {
+      Q_(r, c) = r == c ? 1.0 : 0.0;
+      R_(r, c) = 0.0;
+    }
+    for (int i = 0; i < mc_; ++i) AQ_(i, c) = Acur_(i, c);
+  }
+  cU_.head(mc_) = bcur_.head(mc_);
+  trap_ = false;
+  changes_ = 0;
+  k_ = 0;
+  neq_ = 0;
+  for (int j = 0; j < mi_; ++j) in_ws_(j) = 0;
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addEqualities() {
+  const int nw_keep = nw_;
+  nw_ = 0;
+  for (int i = 0; i < me_; ++i) {
+    for (int c = 0; c < n_; ++c) a_(c) = Es_(i, c);
+    if (nv_ > n_) a_(n_) = 0.0;
+    eq_indep_(i) = 0;
+    if (addRowVector(es_(i))) {
+      eq_indep_(i) = 1;
+      eq_pos_(neq_) = i;
+      ++neq_;
+    }
+  }
+  nw_ = nw_keep;
+  // Consistency of the dependent rows: residual at the minimum-norm point.
+  if (neq_ == me_) return true;
+  for (int i = 0; i < neq_; ++i) {  // Rᵀ y = rhs
+    double s = rhs_(i);
+    for (int j = 0; j < i; ++j) s -= R_(j, i) * y_(j);
+    y_(i) = s / R_(i, i);
+  }
+  for (int r = 0; r < n_; ++r) {  // scratch: xs_ (xc_ holds the iterate)
+    double s = 0.0;
+    for (int i = 0; i < neq_; ++i) s += Q_(r, i) * y_(i);
+    xs_(r) = s;
+  }
+  for (int i = 0; i < me_; ++i) {
+    double s = -es_(i);
+    for (int c = 0; c < n_; ++c) s += Es_(i, c) * xs_(c);
+    if (std::abs(s) > settings_.feasibility_tol) return false;
+  }
+  return true;
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::subproblem() {
+  // x_p = Q₁ R⁻ᵀ rhs: the minimum-norm point of K x = rhs.
+  for (int i = 0; i < k_; ++i) {
+    double s = rhs_(i);
+    for (int j = 0; j < i; ++j) s -= R_(j, i) * y_(j);
+    y_(i) = s / R_(i, i);
+  }
+  const int nz = nv_ - k_;
+  // r = b − A x_p = b − (A Q₁) y ;  M = A Z = (A Q)(:, k:)
+  if (mc_ > 0) {
+    // Rotated residual r̃ = Uᵀ(b − A x_p) = c̃ − G₁ y.
+    r_.head(mc_) = cU_.head(mc_);
+    if (k_ > 0) r_.head(mc_).noalias() -= AQ_.topLeftCorner(mc_, k_) * y_.head(k_);
+    if (nz > 0) {
+      const double tol = settings_.rank_tol * (scale_a_ > 1.0 ? scale_a_ : 1.0);
+      const int r = nz < mc_ ? nz : mc_;
+      bool done = false;
+      if (trap_) {
+        // G_Z = [T 0; 0 0]: p = [T⁻¹ r̃(0:r); 0] is the minimum-norm minimizer.
+        done = true;
+        for (int i = 0; i < r; ++i) done = done && std::abs(AQ_(i, k_ + i)) > tol;
+        if (done) {
+          for (int i = r - 1; i >= 0; --i) {
+            double sum = r_(i);
+            for (int j = i + 1; j < r; ++j) sum -= AQ_(i, k_ + j) * p_(j);
+            p_(i) = sum / AQ_(i, k_ + i);
+          }
+          p_.segment(r, nz - r).setZero();
+        }
+      }
+#ifdef QP_TRACE
+      printf("sub k=%d nz=%d trap=%d done=%d\n", k_, nz, int(trap_), int(done));
+#endif
+      if (!done) {  // generic (rank-deficient, or structure not yet built)
+        M_.topLeftCorner(mc_, nz) = AQ_.block(0, k_, mc_, nz);
+        detail::qpMinNormLeastSquares(M_, mc_, nz, r_, p_, tol, cod_);
+      }
+    }
+  }
+  if (mc_ == 0) p_.head(nz).setZero();
+  // x* = Q [y; p]  (x_p ⊥ range(Z), so the min-norm p gives the min-norm x*).
+  y_.segment(k_, nz) = p_.head(nz);
+  xs_.head(nv_).noalias() = Q_.topLeftCorner(nv_, nv_) * y_.head(nv_);
+  return xs_.head(nv_).allFinite();
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::multipliers() {
+  // Kᵀ λ = −g, g = Aᵀ(A x − b):  R λ = −(A Q₁)ᵀ (A x − b).
+  if (k_ == 0) return true;
+  if (mc_ > 0) {
+    // Uᵀ(A x − b) = G (Qᵀ x) − c̃, and Qᵀ x = y_ = [y; p] from subproblem().
+    r_.head(mc_) = -cU_.head(mc_);
+    r_.head(mc_).noalias() += AQ_.topLeftCorner(mc_, nv_) * y_.head(nv_);
+    y_.head(k_).noalias() = -AQ_.topLeftCorner(mc_, k_).transpose() * r_.head(mc_);
+  } else {
+    y_.head(k_).setZero();
+  }
+  for (int i = k_ - 1; i >= 0; --i) {
+    double s = y_(i);
+    for (int j = i + 1; j < k_; ++j) s -= R_(i, j) * lam_(j);
+    lam_(i) = s / R_(i, i);
+  }
+  return lam_.head(k_).allFinite();
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+double ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::maxViolation(const VecN& v) {
+  double viol = 0.0;
+  if (me_ > 0) {
+    ev_.head(me_).noalias() = Es_.topLeftCorner(me_, n_) * v.head(n_);
+    viol = (ev_.head(me_) - es_.head(me_)).cwiseAbs().maxCoeff();
+  }
+  if (mi_ > 0) {
+    cx_.head(mi_).noalias() = Cs_.topLeftCorner(mi_, n_) * v.head(n_);
+    for (int j = 0; j < mi_; ++j) {
+      if (ls_(j) > -kInf) viol = std::max(viol, ls_(j) - cx_(j));
+      if (us_(j) < kInf) viol = std::max(viol, cx_(j) - us_(j));
+    }
+  }
+  return viol;
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
+  // Primal active-set loop; xc_ is feasible and satisfies K xc_ = rhs.
+  int zero_steps = 0;  // consecutive degenerate steps → smallest-index rule
+  int skip_row = -1;   // a blocking row found dependent on K: ignored until K changes
+  if (mi_ > 0) cx_.head(mi_).noalias() = Cs_.topLeftCorner(mi_, n_) * xc_.head(n_);  // Ĉ x
+  for (;;) {
+    if (!xs_fresh_ && !subproblem()) return QpStatus::NumericalFailure;
+    xs_fresh_ = false;
+    double dn = 0.0, xn = 0.0;
+    for (int i = 0; i < nv_; ++i) {
+      d_(i) = xs_(i) - xc_(i);
+      dn = std::max(dn, std::abs(d_(i)));
+      xn = std::max(xn, std::abs(xc_(i)));
+    }
+    // A step at rounding level is no step: its direction is noise, not in null(K).
+    if (dn <= 1e-14 * (1.0 + xn)) dn = 0.0;
+    // Ratio test over the rows not in K (smallest index wins ties).
+    double alpha = 1.0;
+    int block = -1;
+    bool block_upper = false;
+    const double dir_tol = 10.0 * settings_.rank_tol * dn;
+    if (dn > 0.0 && mi_ > 0) {
+      cd_.head(mi_).noalias() = Cs_.topLeftCorner(mi_, n_) * d_.head(n_);
+      // Phase 1 rows: Ĉx − t ≤ û and Ĉx + t ≥ l̂.
+      const double dt = nv_ > n_ ? d_(n_) : 0.0, xt = nv_ > n_ ? xc_(n_) : 0.0;
+      for (int j = 0; j < mi_; ++j) {
+        if (in_ws_(j) || j == skip_row) continue;
+        // upper side: rises toward û
+        const double adu = cd_(j) - dt;
+        if (adu > dir_tol && us_(j) < kInf) {
+          double slack = us_(j) - (cx_(j) - xt);
+          if (slack < 0.0) slack = 0.0;
+          if (slack < alpha * adu) {
+            alpha = slack / adu;
+            block = j;
+            block_upper = true;
+          }
+        }
+        const double adl = -(cd_(j) + dt);
+        if (adl > dir_tol && ls_(j) > -kInf) {
+          double slack = (cx_(j) + xt) - ls_(j);
+          if (slack < 0.0) slack = 0.0;
+          if (slack < alpha * adl) {
+            alpha = slack / adl;
+            block = j;
+            block_upper = false;
+          }
+        }
+      }
+    }
+    if (dn > 0.0) {
+      xc_.head(nv_) += alpha * d_.head(nv_);
+      if (mi_ > 0) cx_.head(mi_) += alpha * cd_.head(mi_);
+    }
+    // Phase 1 is done as soon as the point is feasible (t ≤ 0 up to rounding).
+    if (phase1 && xc_(n_) <= 1e-3 * settings_.feasibility_tol) return QpStatus::Optimal;
+#ifdef QP_TRACE
+    printf("ph%d k=%d nw=%d dn=%g alpha=%g block=%d up=%d t=%g\n", int(phase1), k_, nw_, dn, alpha, block, int(block_upper), nv_>n_? xc_(n_):0.0);
+#endif
+    if (block >= 0) {
+      if (iterations_ >= settings_.max_iterations) return QpStatus::IterationLimit;
+      ++iterations_;
+      zero_steps = alpha * dn == 0.0 ? zero_steps + 1 : 0;
+      // A row numerically dependent on K cannot be held; skip it until K changes.
+      if (!trap_ && ++changes_ >= kEstablishAfter) establishStructure();
+      skip_row = addRow(block, block_upper) ? -1 : block;
+      continue;
+    }
+    for (int i = 0; i < nv_; ++i) xc_(i) = xs_(i);  // exactly at the subproblem optimum
+    if (!multipliers()) return QpStatus::NumericalFailure;
+    // Most negative multiplier (μ = λ at upper, −λ at lower); smallest index after
+    // repeated degenerate steps (Bland-like anti-cycling). Rows with lower == upper
+    // are equalities: never dropped.
+    double gs = 1.0;
+    for (int i = 0; i < k_; ++i) gs = std::max(gs, std::abs(lam_(i)));
+    const double thr = -settings_.dual_tol * gs;
+    int drop = -1;
+    double worst = thr;
+    const bool bland = zero_steps > 2;
+    for (int w = 0; w < nw_; ++w) {
+      const int j = ws_row_(w);
+      if (ls_(j) == us_(j)) continue;
+      const double mu = ws_upper_(w) ? lam_(neq_ + w) : -lam_(neq_ + w);
+      if (bland) {
+        if (mu < thr && (drop < 0 || j < ws_row_(drop))) drop = w;
+      } else if (mu < worst) {
+        worst = mu;
+        drop = w;
+      }
+    }
+#ifdef QP_TRACE
+    printf("  drop=%d (row %d)\n", drop, drop>=0? ws_row_(drop):-1);
+    for (int w = 0; w < nw_; ++w) printf("   ws %d row %d up %d lam %g\n", w, ws_row_(w), ws_upper_(w), lam_(neq_+w));
+#endif
+    if (drop < 0) return QpStatus::Optimal;
+    if (iterations_ >= settings_.max_iterations) return QpStatus::IterationLimit;
+    ++iterations_;
+    if (!trap_ && ++changes_ >= kEstablishAfter) establishStructure();
+    removeRow(neq_ + drop);
+    skip_row = -1;
+  }
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::finish(QpStatus s) {
+  status_ = s;
+  objective_ = 0.0;
+  for (int i = 0; i < m_; ++i) {
+    double r = -b_(i);
+    for (int c = 0; c < n_; ++c) r += A_(i, c) * x_(c);
+    objective_ += 0.5 * r * r;
+  }
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::solveImpl(const VectorX* x_init,
+                                                               bool warm_start) noexcept {
+  iterations_ = 0;
+  xs_fresh_ = false;
+  for (int i = 0; i < me_; ++i) lam_eq_(i) = 0.0;
+  const bool warm = warm_start && have_ws_;
+  const int nw_prev = nw_;
+  if (!prepare()) {
+    x_.setZero(n_);
+    nw_ = 0;
+    finish(QpStatus::NumericalFailure);
+    return status_;
+  }
+  for (int j = 0; j < mi_; ++j) {
+    if (ls_(j) > us_(j) + settings_.feasibility_tol) {  // empty interval
+      x_.setZero(n_);
+      nw_ = 0;
+      finish(QpStatus::Infeasible);
+      return status_;
+    }
+  }
+  // Phase 2 factorization with the equalities.
+  startPhase(false);
+  nw_ = 0;
+  if (!addEqualities()) {
+    x_.setZero(n_);
+    finish(QpStatus::Infeasible);
+    return status_;
+  }
+  bool started = false;
+  if (warm && nw_prev > 0) {
+    // Re-add the previous working set (dropping dependent rows and infinite sides);
+    // keep it only if its subproblem optimum is feasible.
+    // Copy the previous set first: addRow writes into ws_row_.
+    ws_prev_row_ = ws_row_;
+    ws_prev_upper_ = ws_upper_;
+    nw_ = 0;
+    for (int w = 0; w < nw_prev; ++w) {
+      const int j = ws_prev_row_(w);
+      const bool up = ws_prev_upper_(w) != 0;
+      if (j < 0 || j >= mi_ || in_ws_(j)) continue;
+      if (!(std::abs(up ? us_(j) : ls_(j)) < kInf)) continue;
+      addRow(j, up);
+    }
+    if (subproblem() && maxViolation(xs_) <= settings_.feasibility_tol) {
+      for (int i = 0; i < n_; ++i) xc_(i) = xs_(i);
+      started = true;
+      xs_fresh_ = true;  // iterate() starts from this subproblem solution
+    } else {
+      startPhase(false);
+      nw_ = 0;
+      addEqualities();
+    }
+  }
+  if (!started && x_init != nullptr && x_init->size() == n_) {
+    for (int i = 0; i < n_; ++i) xc_(i) = (*x_init)(i);
+    started = xc_.head(n_).allFinite() && maxViolation(xc_) <= settings_.feasibility_tol;
+  }
+  if (!started) {
+    // Minimum-norm point of E x = e (the subproblem with A = 0 would do the same).
+    for (int i = 0; i < neq_; ++i) {
+      double s = rhs_(i);
+      for (int j = 0; j < i; ++j) s -= R_(j, i) * y_(j);
+      y_(i) = s / R_(i, i);
+    }
+    for (int r = 0; r < n_; ++r) {
+      double s = 0.0;
+      for (int i = 0; i < neq_; ++i) s += Q_(r, i) * y_(i);
+      xc_(r) = s;
+    }
+    const double t0 = maxViolation(xc_);
+    if (t0 > settings_.feasibility_tol) {
+      // Phase 1: min ½t² s.t. Ĉx − t ≤ û, Ĉx + t ≥ l̂, E x = e, from (x_E, t0).
+      startPhase(true);
+      nw_ = 0;
+      addEqualities();
+      xc_(n_) = t0;
+      const QpStatus s1 = iterate(true);
+      if (s1 != QpStatus::Optimal) {
+        x_.setZero(n_);
+        nw_ = 0;
+        finish(s1);
+        return status_;
+      }
+      if (xc_(n_) > settings_.feasibility_tol) {
+        x_.setZero(n_);
+        nw_ = 0;
+        finish(QpStatus::Infeasible);
+        return status_;
+      }
+      startPhase(false);
+      nw_ = 0;
+      addEqualities();
+    }
+  }
+  const QpStatus s2 = iterate(false);
+  if (s2 == QpStatus::NumericalFailure && !xc_.head(n_).allFinite()) {
+    x_.setZero(n_);
+  } else {
+    x_ = xc_.head(n_);
+  }
+  // Report multipliers in the caller's scaling.
+  if (s2 == QpStatus::Optimal) {
+    for (int i = 0; i < neq_; ++i) lam_eq_(eq_pos_(i)) = lam_(i) * einv_(eq_pos_(i));
+    for (int w = 0; w < nw_; ++w) {
+      const int j = ws_row_(w);
+      double mu = (ws_upper_(w) ? lam_(neq_ + w) : -lam_(neq_ + w)) * cinv_(j);
+      if (ls_(j) == us_(j) && mu < 0.0) {  // equality row: report the side by sign
+        ws_upper_(w) = ws_upper_(w) ? 0 : 1;
+        mu = -mu;
+      }
+      ws_mu_(w) = mu;
+    }
+  } else {
+    for (int w = 0; w < nw_; ++w) ws_mu_(w) = 0.0;
+  }
+  have_ws_ = true;
+  finish(s2);
+  return status_;
+}
+
+}  // namespace hqp

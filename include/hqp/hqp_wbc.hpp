@@ -1,0 +1,531 @@
+#pragma once
+// HqpWbc: the strict hierarchy of Section IV-A of the paper (eqs. 3 and 4).
+//
+// Level p (1-based in the paper, 0-based here) is solved in a null-space basis of all
+// higher tasks: x = x*_{p−1} + Z_{p−1} u with Z_0 = I, x*_0 = 0, and
+//   min_u ‖W_p^½ (A_p (x*_{p−1} + Z_{p−1} u) − b_p)‖²
+//   s.t.  lower_k − D_k x*_{p−1} ≤ D_k Z_{p−1} u ≤ upper_k − D_k x*_{p−1}   for all k ≤ p,
+// then x*_p = x*_{p−1} + Z_{p−1} u* and Z_p = Z_{p−1} null(Â_p), Â_p = W_p^½ A_p Z_{p−1} (eq. 4).
+// A basis (not the projector N_p) makes every lower QP smaller: 30 → 24 → 12 → 9 variables
+// for the paper's full-rank levels. Each level's QP is an ActiveSetQp sized at compile time
+// for that level, owned here and warm-started from the previous tick.
+// See docs/hqp.md for the guarantees, the infeasibility policy and the slack option.
+
+#include <Eigen/Core>
+#include <Eigen/QR>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <tuple>
+#include <type_traits>
+#include <utility>
+
+#include "hqp/active_set_qp.hpp"
+#include "hqp/constraint.hpp"
+#include "hqp/hqp_types.hpp"
+#include "hqp/level.hpp"
+#include "hqp/null_space.hpp"
+#include "hqp/task.hpp"
+
+namespace hqp {
+
+struct HqpSettings {
+  QpSettings qp{};          // settings of every level's QP (iteration cap, tolerances)
+  double rank_tol = 1e-9;   // Â_p pivots ≤ rank_tol · (largest weighted row norm of A_p) count as 0
+  bool warm_start = true;   // reuse each level's working set from the previous solve
+};
+
+// What happened at one level; MaxActive = capacity of the stacked constraint rows.
+template <int MaxActive>
+struct HqpLevelResult {
+  QpStatus status = QpStatus::Optimal;
+  double residual = 0.0;    // ‖A_p x* − b_p‖² over the level's tasks at the final x*
+  double objective = 0.0;   // Σ w (a x* − b)², the weighted residual the level minimizes
+  int rank = 0;             // rank of Â_p = W_p^½ A_p Z_{p−1}
+  int null_dim = 0;         // dim of the null space left to lower levels (columns of Z_p)
+  int variables = 0;        // size of this level's QP (columns of Z_{p−1})
+  int iterations = 0;       // QP iterations (plus those of the slack QP)
+  int num_active = 0;       // constraint rows at a bound in this level's QP
+  std::array<int, MaxActive> active_row{};      // index into the stacked constraint rows
+  std::array<bool, MaxActive> active_upper{};   // true: at upper, false: at lower
+  bool constraints_dropped = false;  // infeasible own constraints were dropped (no slack)
+  bool slack_used = false;           // own constraints were relaxed minimally (slack option)
+  double violation = 0.0;            // Σ over own rows of squared bound violation at x*
+};
+
+template <int Nx, int NumLevels, int MaxActive>
+struct HqpResult {
+  Eigen::Matrix<double, Nx, 1> x = Eigen::Matrix<double, Nx, 1>::Zero();  // x*
+  QpStatus status = QpStatus::Optimal;  // first non-optimal level's status, else Optimal
+  int failed_level = -1;                // 0-based index of that level, −1 if none
+  std::array<HqpLevelResult<MaxActive>, NumLevels> levels{};
+};
+
+namespace detail {
+
+// Stands in for a QP object where a level has no constraint at all.
+struct NoQp {
+  NoQp() = default;
+  explicit NoQp(const QpSettings&) {}
+};
+
+template <class... Levels>
+constexpr int maxTaskRows() {
+  int m = 0;
+  ((m = std::max(m, Levels::task_rows)), ...);
+  return m;
+}
+template <class... Levels>
+constexpr int maxConstraintRows() {
+  int m = 0;
+  ((m = std::max(m, Levels::constraint_rows)), ...);
+  return m;
+}
+
+template <class... Levels>
+constexpr int maxSlackRows() {
+  int m = 0;
+  ((m = Levels::slack ? std::max(m, Levels::constraint_rows) : m), ...);
+  return m;
+}
+
+}  // namespace detail
+
+template <int Nx, class... Levels>
+class HqpWbc {
+  static_assert(sizeof...(Levels) > 0, "at least one level");
+  static_assert(((Levels::nx == Nx) && ...), "every level has Nx variables");
+
+ public:
+  static constexpr int nx = Nx;
+  static constexpr int num_levels = static_cast<int>(sizeof...(Levels));
+  static constexpr int total_task_rows = (0 + ... + Levels::task_rows);
+  static constexpr int total_constraint_rows = (0 + ... + Levels::constraint_rows);
+  static constexpr int max_task_rows = detail::maxTaskRows<Levels...>();
+  static constexpr int max_own_constraint_rows = detail::maxConstraintRows<Levels...>();
+  // Level p's rows start at task_offset[p] / constraint_offset[p] in the stacked arrays;
+  // level p's QP sees the constraint rows [0, constraint_offset[p + 1]).
+  static constexpr std::array<int, sizeof...(Levels) + 1> task_offset =
+      detail::rowOffsets<Levels::task_rows...>();
+  static constexpr std::array<int, sizeof...(Levels) + 1> constraint_offset =
+      detail::rowOffsets<Levels::constraint_rows...>();
+  static constexpr int max_active = capacity(total_constraint_rows);
+
+  using VectorX = Eigen::Matrix<double, Nx, 1>;
+  using Result = HqpResult<Nx, num_levels, max_active>;
+  template <int P>
+  using LevelType = std::tuple_element_t<P, std::tuple<Levels...>>;
+  // One QP object per level (each keeps its own warm start), all of one type sized for the
+  // largest level: Nx variables, the most task rows of any level, all constraint rows. One
+  // type instead of one per level keeps compile times down (each ActiveSetQp instantiation
+  // costs ~15 s of compiler time); the storage difference is a few kB per level.
+  using Qp = ActiveSetQp<Nx, capacity(max_task_rows), 2, capacity(total_constraint_rows)>;
+  template <int P>
+  using LevelQp = std::conditional_t<(constraint_offset[P + 1] > 0), Qp, detail::NoQp>;
+  // Slack levels (Level<..., true>): minimal violation of one level's own rows, variables
+  // [u; w] with w the clamped rows. Only compiled in when some level has the option.
+  static constexpr bool has_slack_levels =
+      ((Levels::slack && Levels::constraint_rows > 0) || ...);
+  static constexpr int max_slack_rows = detail::maxSlackRows<Levels...>();
+  using SlackQp = std::conditional_t<
+      has_slack_levels,
+      ActiveSetQp<Nx + capacity(max_slack_rows), capacity(max_slack_rows), 2,
+                  capacity(total_constraint_rows)>,
+      detail::NoQp>;
+
+  explicit HqpWbc(const HqpSettings& settings = {})
+      : settings_(settings),
+        qps_(makeQps(settings.qp, std::make_index_sequence<sizeof...(Levels)>{})),
+        slack_qp_(settings.qp) {}
+
+  // Levels in priority order; fill their tasks and constraints in place before solve().
+  template <int P>
+  LevelType<P>& level() { return std::get<P>(levels_); }
+  template <int P>
+  const LevelType<P>& level() const { return std::get<P>(levels_); }
+
+  // Slack option for level p's own constraints: available for levels declared with it
+  // (Level<..., true> / SoftLevel; off by default, as in the paper); false if not available.
+  bool setSlack(int p, bool on) {
+    if (p < 0 || p >= num_levels || !slack_capable_[static_cast<std::size_t>(p)]) return false;
+    slack_[static_cast<std::size_t>(p)] = on;
+    return true;
+  }
+  bool slack(int p) const { return p >= 0 && p < num_levels && slack_[static_cast<std::size_t>(p)]; }
+
+  const HqpSettings& settings() const { return settings_; }
+  void setRankTolerance(double tol) { settings_.rank_tol = tol; }
+  void setWarmStart(bool on) { settings_.warm_start = on; }
+
+  // Forget every level's working set (the next solve starts cold).
+  void resetWarmStart() {
+    std::apply([](auto&... qp) { (resetQp(qp), ...); }, qps_);
+    resetQp(slack_qp_);
+  }
+
+  // Solves the hierarchy; no heap, no exceptions, bounded by the QPs' iteration caps.
+  QpStatus solve() noexcept {
+    stackAll(std::make_index_sequence<sizeof...(Levels)>{});
+    result_.status = QpStatus::Optimal;
+    result_.failed_level = -1;
+    x_.setZero();
+    Z_.setIdentity(Nx, Nx);
+    n_ = Nx;
+    if constexpr (total_constraint_rows > 0)
+      Dnorm_.head(total_constraint_rows) = D_.topRows(total_constraint_rows).rowwise().norm();
+    if (!inputValid()) {
+      for (auto& lr : result_.levels) lr = HqpLevelResult<max_active>{};
+      result_.status = QpStatus::NumericalFailure;
+      result_.failed_level = 0;
+      result_.levels[0].status = QpStatus::NumericalFailure;
+      result_.x = x_;
+      return result_.status;
+    }
+    solveLevels(std::make_index_sequence<sizeof...(Levels)>{});
+    result_.x = x_;
+    return result_.status;
+  }
+
+  // Level p's QP as last solved (reduced variables u'), for inspection and diagnostics.
+  template <int P>
+  const LevelQp<P>& levelQp() const { return std::get<P>(qps_); }
+
+  const Result& result() const { return result_; }
+  const VectorX& x() const { return x_; }
+  QpStatus status() const { return result_.status; }
+
+ private:
+  using MatrixZ = MaxMatrix<Nx, Nx>;
+  using MatrixM = MaxMatrix<capacity(max_task_rows), Nx>;
+  using VectorM = MaxVector<capacity(max_task_rows)>;
+  using VectorU = MaxVector<Nx>;
+  using VectorC = Eigen::Matrix<double, capacity(total_constraint_rows), 1>;
+  using LeastSquares = std::conditional_t<(constraint_offset[1] == 0),
+                                          Eigen::HouseholderQR<MatrixM>, detail::NoQp>;
+
+  template <std::size_t... I>
+  static std::tuple<LevelQp<static_cast<int>(I)>...> makeQps(const QpSettings& s,
+                                                             std::index_sequence<I...>) {
+    return std::tuple<LevelQp<static_cast<int>(I)>...>((static_cast<void>(I), s)...);
+  }
+  template <std::size_t... I>
+  static auto qpTupleType(std::index_sequence<I...>) -> std::tuple<LevelQp<static_cast<int>(I)>...>;
+  using QpTuple = decltype(qpTupleType(std::make_index_sequence<sizeof...(Levels)>{}));
+
+  template <class Qp>
+  static void resetQp(Qp& qp) {
+    if constexpr (!std::is_same_v<Qp, detail::NoQp>) qp.resetWorkingSet();
+  }
+
+  template <std::size_t... I>
+  void stackAll(std::index_sequence<I...>) {
+    ((std::get<I>(levels_).stackTasks(A_, b_, w_, task_offset[I]),
+      std::get<I>(levels_).stackConstraints(D_, lower_, upper_, constraint_offset[I])),
+     ...);
+  }
+
+  // Rejects NaN anywhere and infinite matrix entries (bounds may be ±inf); never NaN out.
+  bool inputValid() const {
+    if (!A_.allFinite() || !b_.allFinite() || !w_.allFinite() || !D_.allFinite()) return false;
+    if ((w_.array() < 0.0).any()) return false;
+    for (int r = 0; r < total_constraint_rows; ++r)
+      if (std::isnan(lower_(r)) || std::isnan(upper_(r))) return false;
+    return true;
+  }
+
+  template <std::size_t... I>
+  void solveLevels(std::index_sequence<I...>) {
+    (solveLevel<static_cast<int>(I)>(), ...);
+  }
+
+  void noteStatus(int p, QpStatus s) {
+    if (s != QpStatus::Optimal && result_.failed_level < 0) {
+      result_.failed_level = p;
+      result_.status = s;
+    }
+  }
+
+  // Row norms below this count as zero rows when scaling constraint violations.
+  static double rowScale(double norm) { return norm > 1e-300 ? norm : 1.0; }
+
+  template <int P>
+  void solveLevel() {
+    constexpr int r = LevelType<P>::task_rows;
+    constexpr int t0 = task_offset[P];
+    constexpr int c0 = constraint_offset[P];
+    constexpr int c = constraint_offset[P + 1];
+    constexpr int own = c - c0;
+    auto& lr = result_.levels[P];
+    lr = HqpLevelResult<max_active>{};
+    const int n = n_;
+    lr.variables = n;
+
+    if (n == 0) {
+      // Nothing left to move: only check the level's own constraints at x*.
+      if constexpr (own > 0) ownRowsWithoutFreedom<P>(lr);
+      finishLevel<P>(lr);
+      return;
+    }
+
+    // Â_p = W^½ A_p Z_{p−1} (r x n) and its null space (eq. 4).
+    const auto Ap = A_.template middleRows<r>(t0);
+    const auto sw = w_.template segment<r>(t0).cwiseSqrt();
+    M_.resize(r, n);
+    if constexpr (P == 0) {
+      M_ = Ap;  // Z_0 = I
+    } else {
+      M_.noalias() = Ap * Z_;
+    }
+    M_.array().colwise() *= sw.array();
+    const double scale =
+        std::sqrt((Ap.rowwise().squaredNorm().array() * w_.template segment<r>(t0).array()).maxCoeff());
+    ns_.compute(M_, settings_.rank_tol * scale);
+    const int k = ns_.rank();
+    ZQ_ = Z_;
+    ns_.applyQOnTheRight(ZQ_);      // x = x*_{p−1} + ZQ u', u' = [row-space part; null part]
+    ns_.rotatedMatrix(Aq_);         // Â_p Q, truncated to rank k
+    bq_.noalias() = b_.template segment<r>(t0) - Ap * x_;
+    bq_.array() *= sw.array();
+    u_.setZero(n);
+
+    if constexpr (c == 0) {
+      // No constraint anywhere up to this level: the minimum-norm least-squares step,
+      // u' = [argmin ‖L y − b'‖; 0] with L = Â_p Q₁ of full column rank.
+      if (k > 0) {
+        ls_.compute(Aq_.leftCols(k));
+        u_.head(k) = ls_.solve(bq_);
+      }
+      lr.status = QpStatus::Optimal;
+    } else {
+      auto& qp = std::get<P>(qps_);
+      qp.resize(n, r, 0, c);
+      qp.A() = Aq_;
+      qp.b() = bq_;
+      qp.C().noalias() = D_.topRows(c) * ZQ_;
+      dx_.head(c).noalias() = D_.topRows(c) * x_;
+      qp.lower() = lower_.head(c) - dx_.head(c);
+      qp.upper() = upper_.head(c) - dx_.head(c);
+      typename std::remove_reference_t<decltype(qp)>::VectorX hint;
+      hint.setZero(n);  // x*_{p−1} meets every higher constraint: u = 0 is feasible for them
+      const bool locked_infeasible = neutralizeLockedRows(qp, c, c0);
+      QpStatus s = QpStatus::Infeasible;
+      if (!locked_infeasible) {
+        s = qp.solve(hint, settings_.warm_start);
+        lr.iterations = qp.iterations();
+      }
+      if constexpr (own > 0) {
+        if (s == QpStatus::Infeasible) {
+          lr.status = QpStatus::Infeasible;
+          bool relaxed = false;
+          if constexpr (LevelType<P>::slack) {
+            if (slack_[P]) relaxed = relaxOwnRows<P>(qp, n, lr, hint);
+          }
+          if (!relaxed) {
+            // Drop the level's own rows here and in every lower level (docs/hqp.md).
+            lower_.segment(c0, own).setConstant(-kInf);
+            upper_.segment(c0, own).setConstant(kInf);
+            qp.lower().segment(c0, own).setConstant(-kInf);
+            qp.upper().segment(c0, own).setConstant(kInf);
+            lr.constraints_dropped = true;
+            hint.setZero(n);
+          }
+          neutralizeLockedRows(qp, c, c0);  // own rows now hold the hint (slack) or are free
+          qp.resetWorkingSet();
+          const QpStatus s2 = qp.solve(hint, false);
+          lr.iterations += qp.iterations();
+          // The level stays reported Infeasible; a failure of the retry is reported instead.
+          if (s2 != QpStatus::Optimal) lr.status = s2;
+        } else {
+          lr.status = s;
+        }
+      } else {
+        lr.status = s;
+      }
+      if (qp.x().size() == n && qp.x().allFinite()) u_ = qp.x();
+      else if (lr.status == QpStatus::Optimal) lr.status = QpStatus::NumericalFailure;
+      lr.num_active = std::min(qp.numActive(), max_active);
+      for (int a = 0; a < lr.num_active; ++a) {
+        lr.active_row[static_cast<std::size_t>(a)] = qp.activeRow(a);
+        lr.active_upper[static_cast<std::size_t>(a)] = qp.activeAtUpper(a);
+      }
+    }
+
+    x_.noalias() += ZQ_ * u_;
+    Z_ = ZQ_.rightCols(n - k);  // Z_p = Z_{p−1} null(Â_p)
+    n_ = n - k;
+    lr.rank = k;
+    finishLevel<P>(lr);
+  }
+
+  template <int P>
+  void finishLevel(HqpLevelResult<max_active>& lr) {
+    constexpr int r = LevelType<P>::task_rows;
+    constexpr int t0 = task_offset[P];
+    lr.null_dim = n_;
+    const auto e = (A_.template middleRows<r>(t0) * x_ - b_.template segment<r>(t0)).eval();
+    lr.residual = e.squaredNorm();
+    lr.objective = (e.array().square() * w_.template segment<r>(t0).array()).sum();
+    noteStatus(P, lr.status);
+  }
+
+  // Higher rows: their shifted bounds are widened to contain 0 (see below).
+  // Rows whose value the higher levels have locked (‖D_i Z_{p−1}‖ ≤ rank_tol ‖D_i‖) cannot
+  // move any more: they are checked here at x*_{p−1} and handed to the QP as exact zero
+  // rows without bounds, so the QP never sees a rounding-noise row. Returns true if one of
+  // the rows from `own_begin` on is violated (the level is then infeasible).
+  template <class Qp>
+  bool neutralizeLockedRows(Qp& qp, int c, int own_begin) {
+    bool infeasible = false;
+    const double tol = settings_.qp.feasibility_tol;
+    for (int i = 0; i < c; ++i) {
+      const double dn = Dnorm_(i);
+      if (i < own_begin) {
+        // x*_{p−1} met this higher row up to the QP's tolerance; make u = 0 exactly feasible
+        // (a rounding-size empty interval at a degenerate vertex would stall the QP).
+        qp.lower()(i) = std::min(qp.lower()(i), 0.0);
+        qp.upper()(i) = std::max(qp.upper()(i), 0.0);
+      }
+      if (qp.C().row(i).norm() > settings_.rank_tol * dn) continue;
+      const double sc = rowScale(dn);
+      const bool ok = qp.lower()(i) / sc <= tol && -qp.upper()(i) / sc <= tol;
+      qp.C().row(i).setZero();
+      if (ok || i < own_begin) {
+        qp.lower()(i) = -kInf;
+        qp.upper()(i) = kInf;
+      } else {
+        infeasible = true;
+      }
+    }
+    return infeasible;
+  }
+
+  // Own bound violation Σ over rows of max(lower − d, d − upper, 0)² for d = D_own x.
+  template <int P>
+  double ownViolation(const VectorX& x) const {
+    constexpr int c0 = constraint_offset[P];
+    constexpr int own = LevelType<P>::constraint_rows;
+    const Eigen::Matrix<double, own, 1> d = D_.template middleRows<own>(c0) * x;
+    double v = 0.0;
+    for (int i = 0; i < own; ++i) {
+      const double e = std::max(0.0, std::max(lower_(c0 + i) - d(i), d(i) - upper_(c0 + i)));
+      v += e * e;
+    }
+    return v;
+  }
+
+  // Level with no freedom left: its own rows either hold at x* or are infeasible.
+  template <int P>
+  void ownRowsWithoutFreedom(HqpLevelResult<max_active>& lr) {
+    constexpr int c0 = constraint_offset[P];
+    constexpr int own = LevelType<P>::constraint_rows;
+    const Eigen::Matrix<double, own, 1> d = D_.template middleRows<own>(c0) * x_;
+    bool feasible = true;
+    for (int i = 0; i < own; ++i) {
+      const double s = rowScale(D_.row(c0 + i).norm());
+      if ((lower_(c0 + i) - d(i)) / s > settings_.qp.feasibility_tol ||
+          (d(i) - upper_(c0 + i)) / s > settings_.qp.feasibility_tol)
+        feasible = false;
+    }
+    if (feasible) return;
+    lr.status = QpStatus::Infeasible;
+    if (slack_[P]) {
+      lr.violation = ownViolation<P>(x_);
+      lr.slack_used = true;
+      for (int i = 0; i < own; ++i) {
+        lower_(c0 + i) = std::min(lower_(c0 + i), d(i));
+        upper_(c0 + i) = std::max(upper_(c0 + i), d(i));
+      }
+    } else {
+      lower_.segment(c0, own).setConstant(-kInf);
+      upper_.segment(c0, own).setConstant(kInf);
+      lr.constraints_dropped = true;
+    }
+  }
+
+  // Slack option: first the least-squares violation of the level's own rows subject to all
+  // higher constraints, min ‖D_own x − w‖² s.t. lower_own ≤ w ≤ upper_own (w: the clamped
+  // rows); then the own rows are relaxed to contain d* = D_own x_slack, which leaves exactly
+  // the minimal-violation points feasible (docs/hqp.md). Higher constraints get no slack.
+  template <int P, class Qp, class Hint>
+  bool relaxOwnRows(Qp& qp, int n, HqpLevelResult<max_active>& lr, Hint& hint) {
+    if constexpr (std::is_same_v<SlackQp, detail::NoQp>) {
+      return false;
+    } else {
+      constexpr int c0 = constraint_offset[P];
+      constexpr int own = LevelType<P>::constraint_rows;
+      constexpr int c = c0 + own;
+      auto& sq = slack_qp_;
+      sq.resize(n + own, own, 0, c);
+      sq.A().setZero();
+      sq.A().leftCols(n) = qp.C().middleRows(c0, own);
+      sq.A().rightCols(own).diagonal().setConstant(-1.0);
+      sq.b() = -dx_.segment(c0, own);
+      sq.C().setZero();
+      if (c0 > 0) sq.C().topLeftCorner(c0, n) = qp.C().topRows(c0);
+      sq.C().bottomRightCorner(own, own).diagonal().setOnes();
+      if (c0 > 0) {
+        sq.lower().head(c0) = qp.lower().head(c0);
+        sq.upper().head(c0) = qp.upper().head(c0);
+      }
+      sq.lower().tail(own) = lower_.segment(c0, own);
+      sq.upper().tail(own) = upper_.segment(c0, own);
+      typename SlackQp::VectorX start;
+      start.setZero(n + own);
+      for (int i = 0; i < own; ++i)
+        start(n + i) = std::min(std::max(dx_(c0 + i), lower_(c0 + i)), upper_(c0 + i));
+      const QpStatus s = sq.solve(start, false);
+      lr.iterations += sq.iterations();
+      if (s != QpStatus::Optimal || !sq.x().allFinite()) return false;
+      hint = sq.x().head(n);
+      const Eigen::Matrix<double, own, 1> d =
+          dx_.template segment<own>(c0) + qp.C().middleRows(c0, own) * hint;
+      double v = 0.0;
+      for (int i = 0; i < own; ++i) {
+        const double e = std::max(0.0, std::max(lower_(c0 + i) - d(i), d(i) - upper_(c0 + i)));
+        v += e * e;
+        lower_(c0 + i) = std::min(lower_(c0 + i), d(i));
+        upper_(c0 + i) = std::max(upper_(c0 + i), d(i));
+      }
+      qp.lower().segment(c0, own) = lower_.segment(c0, own) - dx_.segment(c0, own);
+      qp.upper().segment(c0, own) = upper_.segment(c0, own) - dx_.segment(c0, own);
+      lr.violation = v;
+      lr.slack_used = true;
+      return true;
+    }
+  }
+
+  HqpSettings settings_;
+  std::tuple<Levels...> levels_;
+  QpTuple qps_;
+  SlackQp slack_qp_;
+  LeastSquares ls_;
+  NullSpace<capacity(max_task_rows), Nx> ns_;
+  std::array<bool, sizeof...(Levels)> slack_{};
+  static constexpr std::array<bool, sizeof...(Levels)> slack_capable_{
+      (Levels::slack && Levels::constraint_rows > 0)...};
+
+  // Stacked data of all levels, copied from the tasks/constraints at the start of solve().
+  Eigen::Matrix<double, capacity(total_task_rows), Nx> A_ = decltype(A_)::Zero();
+  Eigen::Matrix<double, capacity(total_task_rows), 1> b_ = decltype(b_)::Zero();
+  Eigen::Matrix<double, capacity(total_task_rows), 1> w_ = decltype(w_)::Ones();
+  Eigen::Matrix<double, capacity(total_constraint_rows), Nx> D_ = decltype(D_)::Zero();
+  VectorC lower_ = VectorC::Constant(-kInf);
+  VectorC upper_ = VectorC::Constant(kInf);
+  VectorC dx_ = VectorC::Zero();  // D x*_{p−1}
+  VectorC Dnorm_ = VectorC::Zero();  // row norms of D
+
+  // Cascade state and scratch.
+  VectorX x_ = VectorX::Zero();  // x*_p
+  MatrixZ Z_;                    // Z_p (Nx x n_p), orthonormal columns
+  MatrixZ ZQ_;                   // Z_{p−1} Q of the current level
+  int n_ = Nx;
+  MatrixM M_;                    // Â_p
+  MatrixM Aq_;                   // Â_p Q (truncated)
+  VectorM bq_;                   // W^½ (b_p − A_p x*_{p−1})
+  VectorU u_;                    // u' of the current level
+  Result result_{};
+};
+
+}  // namespace hqp

@@ -1,0 +1,348 @@
+// Strict priority with inequalities: HqpWbc's per-level residuals == an independent
+// brute-force cascade (tests/support/reference_cascade.hpp) that imposes the higher levels'
+// optimal task values as explicit equalities, on random 4-level hierarchies.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "hqp/hqp_wbc.hpp"
+#include "hqp/wqp_wbc.hpp"
+#include "support/reference_cascade.hpp"
+
+namespace {
+
+constexpr int N = 7;
+using L1 = hqp::Level<N, hqp::TaskList<hqp::Task<2, N>>, hqp::ConstraintList<hqp::Constraint<2, N>>>;
+// Level 2 (index 1) offers the slack option (off unless a test turns it on).
+using L2 = hqp::SoftLevel<N, hqp::TaskList<hqp::Task<2, N>>, hqp::ConstraintList<hqp::Constraint<2, N>>>;
+using L3 = hqp::Level<N, hqp::TaskList<hqp::Task<2, N>>, hqp::ConstraintList<hqp::Constraint<1, N>>>;
+using L4 = hqp::Level<N, hqp::TaskList<hqp::Task<3, N>>>;
+using Wbc = hqp::HqpWbc<N, L1, L2, L3, L4>;
+using Wqp = hqp::WqpWbc<N, L1, L2, L3, L4>;
+constexpr int kTaskRows[] = {2, 2, 2, 3};
+constexpr int kConRows[] = {2, 2, 1, 0};
+
+Eigen::MatrixXd randn(int r, int c, std::mt19937& g) {
+  std::normal_distribution<double> nd(0.0, 1.0);
+  Eigen::MatrixXd M(r, c);
+  for (int i = 0; i < r; ++i)
+    for (int j = 0; j < c; ++j) M(i, j) = nd(g);
+  return M;
+}
+double unif(std::mt19937& g, double a, double b) {
+  return std::uniform_real_distribution<double>(a, b)(g);
+}
+
+// kind 0: generic; 1: rank-deficient tasks; 2: tasks conflicting across levels;
+// 3: a constraint of level 2 contradicting level 1's task (infeasible level, dropped).
+std::vector<hqp::testing::RefLevel> makeLevels(int kind, std::mt19937& g) {
+  std::vector<hqp::testing::RefLevel> L(4);
+  const Eigen::VectorXd x0 = randn(N, 1, g);  // feasible for every constraint
+  for (int p = 0; p < 4; ++p) {
+    auto& l = L[static_cast<size_t>(p)];
+    l.A = randn(kTaskRows[p], N, g);
+    l.D = randn(kConRows[p], N, g);
+    l.lower.resize(kConRows[p]);
+    l.upper.resize(kConRows[p]);
+    const Eigen::VectorXd d0 = l.D * x0;
+    for (int i = 0; i < kConRows[p]; ++i) {
+      const int side = static_cast<int>(g() % 4);  // 0: two-sided, 1: upper only, 2: lower only
+      l.lower(i) = side == 1 ? -hqp::kInf : d0(i) - unif(g, 0.05, 0.6);
+      l.upper(i) = side == 2 ? hqp::kInf : d0(i) + unif(g, 0.05, 0.6);
+      if (side == 3) l.lower(i) = l.upper(i) = d0(i);  // an equality written as two bounds
+    }
+  }
+  if (kind == 1) {
+    L[1].A = randn(2, 1, g) * randn(1, N, g);
+    L[3].A = randn(3, 2, g) * randn(2, N, g);
+  } else if (kind == 2) {
+    L[1].A.row(0) = L[0].A.row(1);
+    L[2].A = L[1].A + 1e-3 * randn(2, N, g);
+    L[3].A.row(0) = L[0].A.row(0) - L[2].A.row(1);
+  }
+  // Targets far outside the feasible box so that constraints become active.
+  for (int p = 0; p < 4; ++p) {
+    auto& l = L[static_cast<size_t>(p)];
+    l.b = l.A * (x0 + 2.0 * randn(N, 1, g));
+  }
+  if (kind == 3) {
+    // Level 2's first row measures level 1's first task and excludes the value level 1 reaches.
+    L[1].D.row(0) = L[0].A.row(0);
+    L[1].lower(0) = L[0].b(0) + 0.5;
+    L[1].upper(0) = hqp::kInf;
+    L[0].D.setZero();  // keep level 1's own target reachable
+    L[0].lower.setConstant(-1.0);
+    L[0].upper.setConstant(1.0);
+  }
+  return L;
+}
+
+template <class W>
+void fill(W& wbc, const std::vector<hqp::testing::RefLevel>& L) {
+  auto setLevel = [](auto& level, const hqp::testing::RefLevel& l) {
+    level.template task<0>().A = l.A;
+    level.template task<0>().b = l.b;
+    if constexpr (std::decay_t<decltype(level)>::num_constraints > 0) {
+      level.template constraint<0>().D = l.D;
+      level.template constraint<0>().lower = l.lower;
+      level.template constraint<0>().upper = l.upper;
+    }
+  };
+  setLevel(wbc.template level<0>(), L[0]);
+  setLevel(wbc.template level<1>(), L[1]);
+  setLevel(wbc.template level<2>(), L[2]);
+  setLevel(wbc.template level<3>(), L[3]);
+}
+
+// Largest constraint violation (scaled by row norm) of the constraints that were kept.
+double maxViolation(const std::vector<hqp::testing::RefLevel>& L, const Eigen::VectorXd& x,
+                    const std::vector<bool>& dropped) {
+  double v = 0.0;
+  for (size_t p = 0; p < L.size(); ++p) {
+    if (dropped[p]) continue;
+    const Eigen::VectorXd d = L[p].D * x;
+    for (Eigen::Index i = 0; i < d.size(); ++i) {
+      const double s = std::max(L[p].D.row(i).norm(), 1e-12);
+      v = std::max(v, std::max(L[p].lower(i) - d(i), d(i) - L[p].upper(i)) / s);
+    }
+  }
+  return v;
+}
+
+}  // namespace
+
+TEST(HqpInequality, PerLevelResidualsMatchBruteForceCascade) {
+  std::mt19937 g(31);
+  static Wbc wbc;
+  int trials = 0, with_active = 0, lower_active = 0, infeasible = 0;
+  for (int trial = 0; trial < 240; ++trial) {
+    const int kind = trial % 4;
+    const auto L = makeLevels(kind, g);
+    const auto ref = hqp::testing::bruteForceCascade(L, N);
+    fill(wbc, L);
+    const hqp::QpStatus s = wbc.solve();
+    const auto& res = wbc.result();
+    ASSERT_TRUE(res.x.allFinite());
+    bool any_dropped = false;
+    for (int p = 0; p < 4; ++p) {
+      const auto& lr = res.levels[static_cast<size_t>(p)];
+      const double r = ref.residual[static_cast<size_t>(p)];
+      EXPECT_NEAR(lr.residual, r, 1e-8 * (1.0 + r)) << "trial " << trial << " level " << p;
+      EXPECT_EQ(lr.constraints_dropped, ref.dropped[static_cast<size_t>(p)]) << "trial " << trial;
+      any_dropped = any_dropped || lr.constraints_dropped;
+      if (lr.num_active > 0) {
+        ++with_active;
+        lower_active += p >= 2;
+      }
+    }
+    if (any_dropped) {
+      ++infeasible;
+      EXPECT_EQ(s, hqp::QpStatus::Infeasible);
+      int first = 0;
+      while (!ref.dropped[static_cast<size_t>(first)]) ++first;
+      EXPECT_EQ(res.failed_level, first);
+    } else {
+      EXPECT_EQ(s, hqp::QpStatus::Optimal) << "trial " << trial;
+      for (int p = 0; p < 4 && s != hqp::QpStatus::Optimal; ++p)
+        ADD_FAILURE() << "level " << p << ": " << hqp::toString(res.levels[static_cast<size_t>(p)].status)
+                      << " after " << res.levels[static_cast<size_t>(p)].iterations << " iterations";
+    }
+    std::vector<bool> dropped(4);
+    for (int p = 0; p < 4; ++p) dropped[static_cast<size_t>(p)] = res.levels[static_cast<size_t>(p)].constraints_dropped;
+    EXPECT_LT(maxViolation(L, res.x, dropped), 1e-8) << "trial " << trial;
+    ++trials;
+  }
+  EXPECT_EQ(trials, 240);
+  EXPECT_GT(with_active, 200);   // constraints were really active
+  EXPECT_GT(lower_active, 50);   // also in the lower levels' QPs
+  EXPECT_GE(infeasible, 60);     // kind 3 (and some random cases) really were infeasible
+}
+
+TEST(HqpInequality, WarmStartGivesTheColdSolution) {
+  // Ticks of slightly perturbed data: warm and cold solves agree level by level.
+  std::mt19937 g(77);
+  static Wbc warm, cold;
+  cold.setWarmStart(false);
+  auto L = makeLevels(0, g);
+  for (int tick = 0; tick < 50; ++tick) {
+    for (auto& l : L) {
+      l.A += 1e-3 * randn(static_cast<int>(l.A.rows()), N, g);
+      l.b += 1e-3 * randn(static_cast<int>(l.b.size()), 1, g);
+    }
+    fill(warm, L);
+    fill(cold, L);
+    ASSERT_EQ(warm.solve(), cold.solve());
+    for (int p = 0; p < 4; ++p)
+      EXPECT_NEAR(warm.result().levels[static_cast<size_t>(p)].residual,
+                  cold.result().levels[static_cast<size_t>(p)].residual,
+                  1e-9 * (1.0 + cold.result().levels[static_cast<size_t>(p)].residual));
+  }
+}
+
+TEST(HqpInequality, InfeasibleLevelKeepsHigherLevelsAndReportsIt) {
+  std::mt19937 g(5);
+  static Wbc wbc;
+  for (int trial = 0; trial < 20; ++trial) {
+    auto L = makeLevels(3, g);  // level 1 (0-based) contradicts level 0's task
+    fill(wbc, L);
+    ASSERT_EQ(wbc.solve(), hqp::QpStatus::Infeasible);
+    const auto& res = wbc.result();
+    EXPECT_EQ(res.failed_level, 1);
+    EXPECT_EQ(res.levels[1].status, hqp::QpStatus::Infeasible);
+    EXPECT_TRUE(res.levels[1].constraints_dropped);
+    EXPECT_TRUE(res.x.allFinite());
+    // The higher level's residual is the one it has alone (its target is reachable: 0).
+    EXPECT_LT(res.levels[0].residual, 1e-16 * (1.0 + L[0].b.squaredNorm()));
+    // Lower levels are still solved: same residuals as the reference that drops level 1's rows.
+    const auto ref = hqp::testing::bruteForceCascade(L, N);
+    for (int p = 0; p < 4; ++p)
+      EXPECT_NEAR(res.levels[static_cast<size_t>(p)].residual, ref.residual[static_cast<size_t>(p)],
+                  1e-8 * (1.0 + ref.residual[static_cast<size_t>(p)]));
+    // Making the level feasible again leaves level 0's residual unchanged.
+    wbc.level<1>().constraint<0>().lower.setConstant(-hqp::kInf);
+    ASSERT_EQ(wbc.solve(), hqp::QpStatus::Optimal);
+    EXPECT_LT(wbc.result().levels[0].residual, 1e-16 * (1.0 + L[0].b.squaredNorm()));
+  }
+}
+
+TEST(HqpInequality, NanInputNeverGivesNan) {
+  std::mt19937 g(8);
+  static Wbc wbc;
+  auto L = makeLevels(0, g);
+  L[2].A(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  fill(wbc, L);
+  EXPECT_EQ(wbc.solve(), hqp::QpStatus::NumericalFailure);
+  EXPECT_TRUE(wbc.x().allFinite());
+  L = makeLevels(0, g);
+  L[1].lower(0) = std::numeric_limits<double>::quiet_NaN();
+  fill(wbc, L);
+  EXPECT_EQ(wbc.solve(), hqp::QpStatus::NumericalFailure);
+  EXPECT_TRUE(wbc.x().allFinite());
+}
+
+TEST(HqpInequality, SlackViolatesOwnConstraintsMinimally) {
+  // Level 1's own rows: one contradicts level 0's (locked) task, and the two rows
+  // contradict each other along a free direction. With the slack option the violation
+  // is the brute-force minimum and the rest of the cascade matches the reference that
+  // relaxes the rows to the minimal-violation set.
+  std::mt19937 g(12);
+  static Wbc wbc;
+  ASSERT_TRUE(wbc.setSlack(1, true));
+  EXPECT_FALSE(wbc.setSlack(0, true));  // level 0 was not declared with the option
+  int checked = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    auto L = makeLevels(0, g);
+    if (trial % 2 == 0) {
+      L[1].D.row(0) = L[0].A.row(0);
+      L[1].lower(0) = -hqp::kInf;
+      L[1].upper(0) = L[0].b(0) - 0.7;  // level 0 reaches its target unless its rows bind
+      L[0].D *= 1e-3;                    // level 0's rows hardly bind
+    } else {
+      L[1].D.row(1) = L[1].D.row(0);
+      L[1].lower(0) = 1.0;
+      L[1].upper(0) = hqp::kInf;
+      L[1].lower(1) = -hqp::kInf;
+      L[1].upper(1) = -1.0;
+    }
+    std::vector<double> viol;
+    const auto ref = hqp::testing::bruteForceCascade(L, N, 1e-9, {false, true, false, false}, &viol);
+    fill(wbc, L);
+    wbc.solve();
+    const auto& res = wbc.result();
+    ASSERT_TRUE(res.x.allFinite());
+    EXPECT_EQ(res.failed_level, 1) << "trial " << trial;
+    EXPECT_TRUE(res.levels[1].slack_used);
+    EXPECT_FALSE(res.levels[1].constraints_dropped);
+    ASSERT_GT(viol[1], 1e-3);
+    EXPECT_NEAR(res.levels[1].violation, viol[1], 1e-8 * (1.0 + viol[1])) << "trial " << trial;
+    for (int p = 0; p < 4; ++p)
+      EXPECT_NEAR(res.levels[static_cast<size_t>(p)].residual, ref.residual[static_cast<size_t>(p)],
+                  1e-7 * (1.0 + ref.residual[static_cast<size_t>(p)]))
+          << "trial " << trial << " level " << p;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 40);
+  wbc.setSlack(1, false);
+}
+
+TEST(WqpWbc, EqualsBruteForceWeightedQp) {
+  std::mt19937 g(21);
+  static Wqp wqp;
+  int with_active = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const auto L = makeLevels(trial % 3, g);
+    const double ratio = trial % 2 == 0 ? 10.0 : 100.0;
+    wqp.setPriorityRatio(ratio);
+    wqp.level<1>().task<0>().setWeight(trial % 3 == 0 ? 2.0 : 1.0);
+    fill(wqp, L);
+    ASSERT_EQ(wqp.solve(), hqp::QpStatus::Optimal) << "trial " << trial;
+    // The single weighted QP, stacked independently.
+    Eigen::MatrixXd A(9, N), C(5, N);
+    Eigen::VectorXd b(9), lo(5), up(5);
+    int r = 0, c = 0;
+    double lambda = 1.0;
+    for (int p = 0; p < 4; ++p) {
+      const double w = (p == 1 && trial % 3 == 0) ? 2.0 : 1.0;
+      const double s = std::sqrt(lambda * w);
+      const auto& l = L[static_cast<size_t>(p)];
+      A.middleRows(r, l.A.rows()) = s * l.A;
+      b.segment(r, l.b.size()) = s * l.b;
+      r += static_cast<int>(l.A.rows());
+      C.middleRows(c, l.D.rows()) = l.D;
+      lo.segment(c, l.D.rows()) = l.lower;
+      up.segment(c, l.D.rows()) = l.upper;
+      c += static_cast<int>(l.D.rows());
+      lambda /= ratio;
+    }
+    const auto bf = hqp::testing::bruteForceQp(A, b, Eigen::MatrixXd(0, N), Eigen::VectorXd(0), C, lo, up);
+    ASSERT_TRUE(bf.feasible);
+    EXPECT_NEAR(wqp.result().objective, 2.0 * bf.objective, 1e-9 * (1.0 + bf.objective));
+    EXPECT_LT((wqp.x() - bf.x).norm(), 1e-7 * (1.0 + bf.x.norm())) << "trial " << trial;
+    with_active += wqp.result().num_active > 0;
+  }
+  EXPECT_GT(with_active, 30);
+}
+
+TEST(WqpWbc, HugeRatioApproachesTheHierarchy) {
+  // Conflicting tasks without binding constraints: the residuals of the weighted
+  // solution tend to the strict ones as the ratio grows, the gap shrinking with the ratio.
+  std::mt19937 g(44);
+  static Wqp wqp;
+  static Wbc wbc;
+  int checked = 0;
+  for (int trial = 0; trial < 10; ++trial) {
+    auto L = makeLevels(0, g);
+    L[1].A.row(0) = L[0].A.row(1);  // exact conflicts with a higher level, other targets
+    L[2].A.row(1) = L[1].A.row(1);
+    L[3].A.row(0) = L[0].A.row(0);
+    for (auto& l : L) {
+      l.lower.setConstant(-1e3);
+      l.upper.setConstant(1e3);
+    }
+    fill(wbc, L);
+    ASSERT_EQ(wbc.solve(), hqp::QpStatus::Optimal);
+    fill(wqp, L);
+    double prev_gap = hqp::kInf;
+    for (double ratio : {1e2, 1e4, 1e6}) {
+      wqp.setPriorityRatio(ratio);
+      ASSERT_EQ(wqp.solve(), hqp::QpStatus::Optimal);
+      double gap = 0.0;
+      for (int p = 0; p < 3; ++p)
+        gap = std::max(gap, std::abs(wqp.result().residual[static_cast<size_t>(p)] -
+                                     wbc.result().levels[static_cast<size_t>(p)].residual) /
+                                (1.0 + wbc.result().levels[static_cast<size_t>(p)].residual));
+      EXPECT_LT(gap, prev_gap + 1e-12);
+      prev_gap = gap;
+    }
+    EXPECT_LT(prev_gap, 1e-4) << "trial " << trial;
+    // the top level is (nearly) as good as in the hierarchy and never better
+    EXPECT_GE(wqp.result().residual[0] + 1e-9, wbc.result().levels[0].residual);
+    ++checked;
+  }
+  EXPECT_EQ(checked, 10);
+}

@@ -1,0 +1,324 @@
+// Hard and degenerate cases of ActiveSetQp, with expected values from closed
+// forms, the enumeration reference or the recursive pseudo-inverse cascade.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "hqp/active_set_qp.hpp"
+#include "support/brute_force_qp.hpp"
+
+namespace {
+
+using Qp = hqp::ActiveSetQp<8, 12, 4, 12>;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+std::string str(hqp::QpStatus s) { return hqp::toString(s); }
+
+// Feasibility of x for the problem held by qp (scaled rows), computed here.
+double violation(const Qp& qp) {
+  const Eigen::VectorXd x = qp.x();
+  double v = 0.0;
+  for (int i = 0; i < qp.E().rows(); ++i)
+    v = std::max(v, std::abs(qp.E().row(i).dot(x) - qp.e()(i)) / qp.E().row(i).norm());
+  for (int j = 0; j < qp.C().rows(); ++j) {
+    const double nrm = std::max(qp.C().row(j).norm(), 1e-300);
+    const double cx = qp.C().row(j).dot(x);
+    if (std::isfinite(qp.lower()(j))) v = std::max(v, (qp.lower()(j) - cx) / nrm);
+    if (std::isfinite(qp.upper()(j))) v = std::max(v, (cx - qp.upper()(j)) / nrm);
+  }
+  return v;
+}
+
+hqp::testing::BruteForceResult reference(const Qp& qp) {
+  return hqp::testing::bruteForceQp(qp.A(), qp.b(), qp.E(), qp.e(), qp.C(), qp.lower(),
+                                    qp.upper());
+}
+
+TEST(QpHard, DegenerateVertexWithDuplicatedRows) {
+  // min ½‖x − 1‖² s.t. x_i ≤ 0, x1 + x2 ≤ 0, x1 + x2 + x3 ≤ 0, x1 ≤ 0 twice more,
+  // 2 x2 ≤ 0: 8 rows active at the optimum x = 0 in R³ (closed form, objective 1.5).
+  Qp qp;
+  qp.resize(3, 3, 0, 8);
+  qp.A().setIdentity();
+  qp.b().setOnes();
+  qp.C() << 1, 0, 0,  0, 1, 0,  0, 0, 1,  1, 1, 0,  1, 1, 1,  1, 0, 0,  1, 0, 0,  0, 2, 0;
+  qp.lower().setConstant(-kInf);
+  qp.upper().setZero();
+  ASSERT_EQ(str(qp.solve(false)), "Optimal");
+  EXPECT_LE(qp.x().cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_NEAR(qp.objective(), 1.5, 1e-12);
+  EXPECT_LE(qp.numActive(), 3);  // an independent subset of the 8 active rows
+  // Stationarity from the reported multipliers: x − 1 + Σ μ c = 0.
+  Eigen::Vector3d s = qp.x() - Eigen::Vector3d::Ones();
+  for (int k = 0; k < qp.numActive(); ++k) {
+    EXPECT_GE(qp.multiplier(k), 0.0);
+    EXPECT_TRUE(qp.activeAtUpper(k));
+    s += qp.multiplier(k) * qp.C().row(qp.activeRow(k)).transpose();
+  }
+  EXPECT_LE(s.norm(), 1e-12);
+}
+
+TEST(QpHard, DegeneratePyramidApexMatchesBruteForce) {
+  // 8 planes through the apex of a pyramid in R³, objective pulls above the apex.
+  Qp qp;
+  qp.resize(3, 3, 0, 8);
+  qp.A().setIdentity();
+  qp.b() << 0.1, -0.2, 5.0;
+  for (int j = 0; j < 8; ++j) {
+    const double th = 2.0 * M_PI * j / 8.0;
+    qp.C().row(j) << std::cos(th), std::sin(th), 0.5;
+  }
+  qp.lower().setConstant(-kInf);
+  qp.upper().setZero();
+  ASSERT_EQ(str(qp.solve(false)), "Optimal");
+  const auto ref = reference(qp);
+  ASSERT_TRUE(ref.feasible);
+  EXPECT_NEAR(qp.objective(), ref.objective, 1e-10);
+  EXPECT_LE((qp.x() - ref.x).norm(), 1e-9);  // strictly convex: unique optimum
+}
+
+TEST(QpHard, RedundantConsistentEqualities) {
+  // E = [e1; e1; 2 e1; e1 + e2; e2], consistent: x1 = 1, x2 = -1; min ½‖x‖² ⇒ x = (1, -1, 0).
+  hqp::ActiveSetQp<3, 3, 5, 1> qp;
+  qp.resize(3, 3, 5, 0);
+  qp.A().setIdentity();
+  qp.b().setZero();
+  qp.E() << 1, 0, 0,  1, 0, 0,  2, 0, 0,  1, 1, 0,  0, 1, 0;
+  qp.e() << 1, 1, 2, 0, -1;
+  ASSERT_EQ(str(qp.solve(false)), "Optimal");
+  EXPECT_LE((qp.x() - Eigen::Vector3d(1, -1, 0)).norm(), 1e-12);
+  // Stationarity with the equality multipliers: x + Eᵀλ = 0.
+  EXPECT_LE((qp.x() + qp.E().transpose() * qp.equalityMultipliers()).norm(), 1e-12);
+}
+
+TEST(QpHard, InconsistentEqualitiesAreInfeasible) {
+  hqp::ActiveSetQp<3, 3, 3, 1> qp;
+  qp.resize(3, 3, 3, 0);
+  qp.A().setIdentity();
+  qp.b().setOnes();
+  qp.E() << 1, 0, 0,  0, 1, 0,  1, 1, 0;
+  qp.e() << 1, 1, 3;  // x1 + x2 = 2 ≠ 3
+  EXPECT_EQ(str(qp.solve(false)), "Infeasible");
+  EXPECT_TRUE(qp.x().allFinite());
+}
+
+TEST(QpHard, InfeasibleInequalities) {
+  Qp qp;
+  qp.resize(2, 2, 0, 3);
+  qp.A().setIdentity();
+  qp.b().setZero();
+  qp.C() << 1, 0,  1, 0,  0, 1;
+  qp.lower() << 1.0, -kInf, -kInf;
+  qp.upper() << kInf, 0.0, kInf;  // x1 ≥ 1 and x1 ≤ 0
+  EXPECT_EQ(str(qp.solve(false)), "Infeasible");
+  EXPECT_TRUE(qp.x().allFinite());
+  EXPECT_FALSE(reference(qp).feasible);
+  // lower > upper on a single row.
+  qp.lower() << 1.0, -kInf, -kInf;
+  qp.upper() << 0.5, kInf, kInf;
+  EXPECT_EQ(str(qp.solve(false)), "Infeasible");
+  // Infeasible only together with an equality: x1 + x2 = 4, x1 ≤ 1, x2 ≤ 1.
+  hqp::ActiveSetQp<2, 2, 1, 2> q2;
+  q2.resize(2, 2, 1, 2);
+  q2.A().setIdentity();
+  q2.b().setZero();
+  q2.E() << 1, 1;
+  q2.e() << 4;
+  q2.C().setIdentity();
+  q2.lower().setConstant(-kInf);
+  q2.upper().setConstant(1.0);
+  EXPECT_EQ(str(q2.solve(false)), "Infeasible");
+  EXPECT_TRUE(q2.x().allFinite());
+}
+
+TEST(QpHard, SemidefiniteReturnsMinimumNorm) {
+  // A = [1 1 0 0], b = 2: optimal set x1 + x2 = 2; min-norm x = (1, 1, 0, 0).
+  Qp qp;
+  qp.resize(4, 1, 0, 0);
+  qp.A() << 1, 1, 0, 0;
+  qp.b() << 2;
+  ASSERT_EQ(str(qp.solve(false)), "Optimal");
+  EXPECT_LE((qp.x() - Eigen::Vector4d(1, 1, 0, 0)).norm(), 1e-12);
+  // With x1 ≤ 0.5 active: minimizers x1 = 0.5, x2 = 1.5, x3, x4 free → min-norm on
+  // the working set gives x3 = x4 = 0.
+  qp.resize(4, 1, 0, 1);
+  qp.A() << 1, 1, 0, 0;
+  qp.b() << 2;
+  qp.C() << 1, 0, 0, 0;
+  qp.lower() << -kInf;
+  qp.upper() << 0.5;
+  ASSERT_EQ(str(qp.solve(false)), "Optimal");
+  EXPECT_NEAR(qp.objective(), 0.0, 1e-14);
+  EXPECT_LE((qp.x() - Eigen::Vector4d(0.5, 1.5, 0, 0)).norm(), 1e-12);
+}
+
+TEST(QpHard, NoObjectiveRowsGivesMinNormFeasiblePoint) {
+  Qp qp;
+  qp.resize(2, 0, 1, 0);
+  qp.E() << 1, 1;
+  qp.e() << 2;
+  ASSERT_EQ(str(qp.solve(false)), "Optimal");
+  EXPECT_LE((qp.x() - Eigen::Vector2d(1, 1)).norm(), 1e-12);
+  EXPECT_EQ(qp.objective(), 0.0);
+}
+
+TEST(QpHard, ZeroRowsInfiniteBoundsAndFixedRows) {
+  Qp qp;
+  qp.resize(3, 3, 0, 4);
+  qp.A().setIdentity();
+  qp.b() << 1, 2, 3;
+  qp.C() << 0, 0, 0,  1, 0, 0,  0, 1, 0,  0, 0, 1;
+  qp.lower() << -1, -kInf, 0.5, -kInf;   // zero row with 0 inside [−1, 1]: no constraint
+  qp.upper() << 1, kInf, 0.5, 2.0;       // row 1 free, row 2 fixed x2 = 0.5, x3 ≤ 2
+  ASSERT_EQ(str(qp.solve(false)), "Optimal");
+  EXPECT_LE((qp.x() - Eigen::Vector3d(1, 0.5, 2)).norm(), 1e-12);
+  // Multipliers: x − b + Σ ±μ c = 0 ⇒ fixed row x2: μ = 1.5 reported at the upper
+  // side (x2 − 2 + μ = 0); x3 ≤ 2: μ = 1.
+  int found = 0;
+  for (int k = 0; k < qp.numActive(); ++k) {
+    if (qp.activeRow(k) == 2) {
+      EXPECT_TRUE(qp.activeAtUpper(k));
+      EXPECT_NEAR(qp.multiplier(k), 1.5, 1e-12);
+      ++found;
+    }
+    if (qp.activeRow(k) == 3) {
+      EXPECT_TRUE(qp.activeAtUpper(k));
+      EXPECT_NEAR(qp.multiplier(k), 1.0, 1e-12);
+      ++found;
+    }
+  }
+  EXPECT_EQ(found, 2);
+  // Fixed row pushed from the other side: b2 = −2 ⇒ μ = 2.5 at the lower side.
+  qp.b() << 1, -2, 3;
+  ASSERT_EQ(str(qp.solve(false)), "Optimal");
+  for (int k = 0; k < qp.numActive(); ++k)
+    if (qp.activeRow(k) == 2) {
+      EXPECT_FALSE(qp.activeAtUpper(k));
+      EXPECT_NEAR(qp.multiplier(k), 2.5, 1e-12);
+    }
+  // A zero row whose bounds exclude 0 is infeasible.
+  qp.lower()(0) = 0.5;
+  EXPECT_EQ(str(qp.solve(false)), "Infeasible");
+}
+
+TEST(QpHard, MultiplierScalingAndSides) {
+  // min ½(x − 2)² s.t. 2x ≤ 2  ⇒ x = 1, g = −1, g + 2μ = 0 ⇒ μ = 0.5 (upper).
+  hqp::ActiveSetQp<1, 1, 1, 1> qp;
+  qp.resize(1, 1, 0, 1);
+  qp.A() << 1;
+  qp.b() << 2;
+  qp.C() << 2;
+  qp.lower() << -kInf;
+  qp.upper() << 2;
+  ASSERT_EQ(str(qp.solve(false)), "Optimal");
+  EXPECT_NEAR(qp.x()(0), 1.0, 1e-14);
+  ASSERT_EQ(qp.numActive(), 1);
+  EXPECT_TRUE(qp.activeAtUpper(0));
+  EXPECT_NEAR(qp.multiplier(0), 0.5, 1e-14);
+  // min ½(x + 2)² s.t. −3 ≤ 3x  ⇒ x = −1, g = 1, g − 3μ = 0 ⇒ μ = 1/3 (lower).
+  qp.b() << -2;
+  qp.C() << 3;
+  qp.lower() << -3;
+  qp.upper() << kInf;
+  ASSERT_EQ(str(qp.solve(false)), "Optimal");
+  EXPECT_NEAR(qp.x()(0), -1.0, 1e-14);
+  ASSERT_EQ(qp.numActive(), 1);
+  EXPECT_FALSE(qp.activeAtUpper(0));
+  EXPECT_NEAR(qp.multiplier(0), 1.0 / 3.0, 1e-14);
+}
+
+TEST(QpHard, EqualityOnlyEqualsPseudoInverseCascade) {
+  // Rank-deficient A and E: x = E⁺e + (A P)⁺ (b − A E⁺e), P = I − E⁺E (eq. 4 with
+  // two levels), computed here with SVD pseudo-inverses.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> U(-1, 1);
+  for (int trial = 0; trial < 50; ++trial) {
+    const int n = 8, m = 7, me = 4;
+    Eigen::MatrixXd A = Eigen::MatrixXd::NullaryExpr(m, 3, [&] { return U(rng); }) *
+                        Eigen::MatrixXd::NullaryExpr(3, n, [&] { return U(rng); });
+    Eigen::MatrixXd E = Eigen::MatrixXd::NullaryExpr(me, n, [&] { return U(rng); });
+    E.row(3) = E.row(0) + E.row(1);  // rank 3
+    const Eigen::VectorXd b = Eigen::VectorXd::NullaryExpr(m, [&] { return U(rng); });
+    const Eigen::VectorXd e = E * Eigen::VectorXd::NullaryExpr(n, [&] { return U(rng); });
+    auto pinv = [](const Eigen::MatrixXd& M) {
+      Eigen::JacobiSVD<Eigen::MatrixXd> svd(M, Eigen::ComputeThinU | Eigen::ComputeThinV);
+      Eigen::VectorXd s = svd.singularValues();
+      for (int i = 0; i < s.size(); ++i) s(i) = s(i) > 1e-10 * s(0) ? 1.0 / s(i) : 0.0;
+      return Eigen::MatrixXd(svd.matrixV() * s.asDiagonal() * svd.matrixU().transpose());
+    };
+    const Eigen::MatrixXd Ep = pinv(E);
+    const Eigen::MatrixXd P = Eigen::MatrixXd::Identity(n, n) - Ep * E;
+    const Eigen::VectorXd x1 = Ep * e;
+    const Eigen::VectorXd expected = x1 + pinv(A * P) * (b - A * x1);
+    Qp qp;
+    qp.resize(n, m, me, 0);
+    qp.A() = A;
+    qp.b() = b;
+    qp.E() = E;
+    qp.e() = e;
+    ASSERT_EQ(str(qp.solve(false)), "Optimal");
+    EXPECT_LE((qp.x() - expected).norm(), 1e-9 * (1.0 + expected.norm())) << trial;
+  }
+}
+
+TEST(QpHard, IterationCapReturnsFeasibleIterate) {
+  // Box |x_i| ≤ 1 with the target outside in every coordinate: 8 rows to add from 0.
+  Qp qp;
+  qp.settings().max_iterations = 3;
+  qp.resize(8, 8, 0, 8);
+  qp.A().setIdentity();
+  for (int i = 0; i < 8; ++i) qp.b()(i) = 2.0 + i;
+  qp.C().setIdentity();
+  qp.lower().setConstant(-1.0);
+  qp.upper().setConstant(1.0);
+  EXPECT_EQ(str(qp.solve(false)), "IterationLimit");
+  EXPECT_EQ(qp.iterations(), 3);
+  EXPECT_TRUE(qp.x().allFinite());
+  EXPECT_LE(violation(qp), 1e-12);
+  // Same with phase 1 needed: the cap stops phase 1 ⇒ no feasible iterate ⇒ x = 0.
+  qp.lower().setConstant(1.5);
+  qp.upper().setConstant(2.0);
+  EXPECT_EQ(str(qp.solve(false)), "IterationLimit");
+  EXPECT_EQ(qp.x().norm(), 0.0);
+  qp.settings().max_iterations = 100;
+  ASSERT_EQ(str(qp.solve(false)), "Optimal");
+  for (int i = 0; i < 8; ++i) EXPECT_NEAR(qp.x()(i), 2.0, 1e-12);
+}
+
+TEST(QpHard, NonFiniteInputIsNumericalFailure) {
+  Qp qp;
+  qp.resize(2, 2, 0, 0);
+  qp.A().setIdentity();
+  qp.b() << 1, std::numeric_limits<double>::quiet_NaN();
+  const auto s = qp.solve(false);
+  EXPECT_EQ(str(s), "NumericalFailure");
+  EXPECT_TRUE(qp.x().allFinite());
+}
+
+TEST(QpHard, HessianForm) {
+  // ½xᵀHx + gᵀx with H = MᵀM singular (rank 2 in R³), g ∈ range(H); x ≤ constraints.
+  Eigen::MatrixXd M(2, 3);
+  M << 1, 2, 0, 0, 1, 1;
+  const Eigen::MatrixXd H = M.transpose() * M;
+  const Eigen::VectorXd g = H * Eigen::Vector3d(1, -1, 2);  // minimizers: x − (−1, 1, −2) ∈ null(H)
+  Qp qp;
+  qp.resize(3, 1, 0, 0);
+  ASSERT_TRUE(qp.setHessianForm(H, g));
+  ASSERT_EQ(str(qp.solve(false)), "Optimal");
+  // Stationarity H x + g = 0 and min-norm: x ⊥ null(H) = span((2, −1, 1)).
+  EXPECT_LE((H * qp.x() + g).norm(), 1e-10);
+  EXPECT_NEAR(qp.x().dot(Eigen::Vector3d(2, -1, 1)), 0.0, 1e-10);
+  // Not PSD, and g ∉ range(H) (unbounded below): rejected.
+  Eigen::MatrixXd Hn = H;
+  Hn(0, 0) = -1;
+  EXPECT_FALSE(qp.setHessianForm(Hn, g));
+  EXPECT_FALSE(qp.setHessianForm(H, Eigen::Vector3d(2, -1, 1)));
+}
+
+// Unbounded problems cannot occur in the least-squares form: ½‖Ax − b‖² ≥ 0 is
+// bounded below on any feasible set, so there is no "unbounded" status to test
+// (setHessianForm rejects Hessian forms that would be unbounded).
+
+}  // namespace
