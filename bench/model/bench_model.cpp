@@ -115,8 +115,8 @@ struct Mujoco {
   std::vector<mjtNum> M, jac_l, jac_r, jac_t, jacr_l, jacr_r, jacr_t, jac_com, bias;
   int l = -1, r = -1, t = -1;
   Mujoco() {
-    m = hqp::test::loadUrdfFileIntoMujoco(std::string(HQP_SOURCE_DIR) + "/robots/walker3/walker3.urdf",
-                                          true);
+    const std::string urdf = std::string(HQP_SOURCE_DIR) + "/robots/walker3/walker3.urdf";
+    m = hqp::test::loadUrdfFileIntoMujoco(urdf, true);
     d.reset(mj_makeData(m.get()));
     const int nv = m->nv;
     M.resize(static_cast<std::size_t>(nv * nv));

@@ -5,12 +5,15 @@
 // The Hessian AᵀA is only positive SEMI-definite (rank-deficient A is the normal
 // case in the lower levels), so the method never forms or inverts it:
 //  - the working set K = [E_indep; C_W] is kept as an incrementally updated QR
-//    factorization Kᵀ = Q [R; 0] (Givens rotations on add / remove), Z = Q(:, k:)
-//    spans its null space, and A Q is updated with the same rotations;
+//    factorization Kᵀ = Q [R; 0] (a reflector or Givens rotations per added row,
+//    Givens per removed row), Z = Q(:, k:) spans its null space, and G = Uᵀ A Q is
+//    updated with the same rotations;
 //  - the subproblem optimum on the working set is x* = x_p + Z (A Z)⁺ (b − A x_p)
-//    with x_p the minimum-norm point of K x = rhs; (A Z)⁺ by a complete orthogonal
-//    decomposition, so the step is defined for any rank and x* is the minimum-norm
-//    minimizer on the working set;
+//    with x_p the minimum-norm point of K x = rhs, so the step is defined for any
+//    rank and x* is the minimum-norm minimizer on the working set. After two
+//    working-set changes G_Z = Uᵀ A Z is kept in the form [T 0; 0 0] (T upper
+//    triangular) and (A Z)⁺ is a triangular solve; before that, or if T is
+//    numerically singular, a complete orthogonal decomposition is used;
 //  - multipliers by Kᵀ λ = −Aᵀ(A x − b) through the same QR;
 //  - phase 1 is the same method on min ½t² s.t. lower − t ≤ Ĉ x ≤ upper + t, E x = e
 //    (Ĉ: rows scaled to unit norm).
@@ -51,7 +54,6 @@ class ActiveSetQp {
     return max_rows == 1 && MaxN != 1 ? Eigen::RowMajor : Eigen::ColMajor;
   }
 
- public:
   using MatrixA =
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, storage(MaxRows), MaxRows, MaxN>;
   using MatrixE =
@@ -189,8 +191,6 @@ class ActiveSetQp {
   // Current phase.
   int nv_ = 0;     // variables: n (phase 2) or n + 1 (phase 1)
   int mc_ = 0;     // objective rows
-  Eigen::Matrix<double, MR, NV> Acur_;
-  Eigen::Matrix<double, MR, 1> bcur_;
 
   // Working set K (k_ rows: neq_ equalities, then nw_ inequalities).
   int k_ = 0, neq_ = 0, nw_ = 0;
@@ -501,12 +501,12 @@ bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::prepare() {
   // Rows scaled to unit norm (zero rows stay zero); non-finite data is rejected
   // (±inf bounds are allowed, NaN bounds are not).
   if (n_ <= 0) return true;
-  if (!A_.allFinite() || !b_.allFinite() || !E_.allFinite() || !e_.allFinite() ||
-      !C_.allFinite())
-    return false;
+  // A row norm is finite iff the row is.
+  if (!b_.allFinite() || !e_.allFinite()) return false;
   if (mi_ > 0) {
     if (lower_.hasNaN() || upper_.hasNaN()) return false;
     cinv_.head(mi_) = C_.rowwise().norm();
+    if (!cinv_.head(mi_).allFinite()) return false;
     for (int j = 0; j < mi_; ++j) cinv_(j) = cinv_(j) > 0.0 ? 1.0 / cinv_(j) : 1.0;
     Cs_.topLeftCorner(mi_, n_) = cinv_.head(mi_).asDiagonal() * C_;
     ls_.head(mi_) = lower_.cwiseProduct(cinv_.head(mi_));
@@ -515,37 +515,33 @@ bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::prepare() {
   }
   if (me_ > 0) {
     einv_.head(me_) = E_.rowwise().norm();
+    if (!einv_.head(me_).allFinite()) return false;
     for (int i = 0; i < me_; ++i) einv_(i) = einv_(i) > 0.0 ? 1.0 / einv_(i) : 1.0;
     Es_.topLeftCorner(me_, n_) = einv_.head(me_).asDiagonal() * E_;
     es_.head(me_) = e_.cwiseProduct(einv_.head(me_));
   }
   scale_a_ = m_ > 0 ? A_.norm() : 0.0;
-  return true;
+  return std::isfinite(scale_a_);
 }
 
 template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
 void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::startPhase(bool phase1) {
+  // Q = I, G = A (phase 1: A = e_tᵀ, b = 0 for ½t²), c̃ = b. R is written column by
+  // column as rows are added.
   nv_ = phase1 ? n_ + 1 : n_;
+  Q_.topLeftCorner(nv_, nv_).setIdentity();
   if (phase1) {
-    mc_ = 1;  // ½t²
-    for (int i = 0; i < nv_; ++i) Acur_(0, i) = 0.0;
-    Acur_(0, n_) = 1.0;
-    bcur_(0) = 0.0;
+    mc_ = 1;
+    AQ_.row(0).head(nv_).setZero();
+    AQ_(0, n_) = 1.0;
+    cU_(0) = 0.0;
   } else {
     mc_ = m_;
-    for (int i = 0; i < m_; ++i) {
-      for (int c = 0; c < n_; ++c) Acur_(i, c) = A_(i, c);
-      bcur_(i) = b_(i);
+    if (m_ > 0) {
+      AQ_.topLeftCorner(m_, n_) = A_;
+      cU_.head(m_) = b_;
     }
   }
-  for (int c = 0; c < nv_; ++c) {
-    for (int r = 0; r < nv_; ++r) {
-      Q_(r, c) = r == c ? 1.0 : 0.0;
-      R_(r, c) = 0.0;
-    }
-    for (int i = 0; i < mc_; ++i) AQ_(i, c) = Acur_(i, c);
-  }
-  cU_.head(mc_) = bcur_.head(mc_);
   trap_ = false;
   changes_ = 0;
   k_ = 0;
@@ -619,9 +615,6 @@ bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::subproblem() {
           p_.segment(r, nz - r).setZero();
         }
       }
-#ifdef QP_TRACE
-      printf("sub k=%d nz=%d trap=%d done=%d\n", k_, nz, int(trap_), int(done));
-#endif
       if (!done) {  // generic (rank-deficient, or structure not yet built)
         M_.topLeftCorner(mc_, nz) = AQ_.block(0, k_, mc_, nz);
         detail::qpMinNormLeastSquares(M_, mc_, nz, r_, p_, tol, cod_);
@@ -729,9 +722,6 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
     }
     // Phase 1 is done as soon as the point is feasible (t ≤ 0 up to rounding).
     if (phase1 && xc_(n_) <= 1e-3 * settings_.feasibility_tol) return QpStatus::Optimal;
-#ifdef QP_TRACE
-    printf("ph%d k=%d nw=%d dn=%g alpha=%g block=%d up=%d t=%g\n", int(phase1), k_, nw_, dn, alpha, block, int(block_upper), nv_>n_? xc_(n_):0.0);
-#endif
     if (block >= 0) {
       if (iterations_ >= settings_.max_iterations) return QpStatus::IterationLimit;
       ++iterations_;
@@ -763,10 +753,6 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
         drop = w;
       }
     }
-#ifdef QP_TRACE
-    printf("  drop=%d (row %d)\n", drop, drop>=0? ws_row_(drop):-1);
-    for (int w = 0; w < nw_; ++w) printf("   ws %d row %d up %d lam %g\n", w, ws_row_(w), ws_upper_(w), lam_(neq_+w));
-#endif
     if (drop < 0) return QpStatus::Optimal;
     if (iterations_ >= settings_.max_iterations) return QpStatus::IterationLimit;
     ++iterations_;

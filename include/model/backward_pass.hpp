@@ -31,10 +31,8 @@ inline void backwardPass(Data<Robot>& d, typename Data<Robot>::VectorV& tau) noe
   static_assert(!mass_matrix || composite, "M needs the composite inertias");
   constexpr int first = Robot::floating_base ? 1 : 0;
 
-  if constexpr (composite) {
-    for (int i = 0; i < Data<Robot>::nb; ++i) d.Ic[i] = d.Ib[i];
-    d.Itot.setZero();
-  }
+  // d.Ic holds the body inertias from the forward sweep; they are summed in place.
+  if constexpr (composite) d.Itot.setZero();
   if constexpr (mass_matrix) d.M.setZero();
   if constexpr (forces) d.ftot.setZero();
 

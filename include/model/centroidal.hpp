@@ -1,8 +1,9 @@
 #pragma once
 // Centre of mass and centroidal momentum (Wensing & Orin 2016; Orin, Goswami
 // & Lee 2013), from by-products of CRBA and RNEA in world-origin coordinates:
-//   h_O = Σ_i I_i V_i = Σ_i (Ic_i S_i) q̇_i        → column i of A_G at O is F_i = Ic_i S_i
-//   ḣ_O(q̈ = 0) = Σ_i (I_i A_i + V_i ×* I_i V_i)    = f_tot + I_tot a_g (RNEA forces, gravity removed)
+//   h_O = Σ_i I_i V_i = Σ_i (Ic_i S_i) q̇_i, so column i of A_G at O is F_i = Ic_i S_i
+//   ḣ_O(q̈ = 0) = Σ_i (I_i A_i + V_i ×* I_i V_i) = f_tot + I_tot a_g
+//                (the RNEA forces summed over the roots, gravity removed)
 // and the shift to the CoM c: [P; L_G] = [P; L_O − c × P]. Since ċ ∥ P,
 // d/dt L_G = d/dt L_O − c × Ṗ, so Ȧ_G v is shifted the same way.
 // Jcom = A_G(linear) / m; c = h / m of the total inertia.

@@ -54,8 +54,8 @@ struct Data {
 
   // ---- dynamics scratch ----
   std::array<Vector6, nb> Aq;             // acceleration with q̈ (rnea)
-  std::array<SpatialInertia, nb> Ib;      // body inertia (world origin)
-  std::array<SpatialInertia, nb> Ic;      // composite inertia of the subtree
+  std::array<SpatialInertia, nb> Ic;      // body inertia after the forward sweep, composite
+                                          // inertia of the subtree after the backward sweep
   std::array<Vector6, nb> f;              // subtree force (world origin) after rnea
   std::array<Vector6, nb> F;              // Ic S of 1-DoF bodies: column of A_G at the origin
   Matrix6 F0;                             // Ic_0 S_0 of a floating base (6 columns)
@@ -106,7 +106,6 @@ struct Data {
       V[i].setZero();
       A[i].setZero();
       Aq[i].setZero();
-      Ib[i].setZero();
       Ic[i].setZero();
       f[i].setZero();
       F[i].setZero();

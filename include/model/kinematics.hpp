@@ -26,18 +26,20 @@ namespace detail {
 enum ForwardFlags : unsigned {
   kMotion = 1u,   // twists V and bias accelerations
   kAccel = 2u,    // add S q̈ (writes Data::Aq instead of Data::A)
-  kInertia = 4u,  // body inertias Ib in world coordinates
+  kInertia = 4u,  // body inertias in world coordinates, into Data::Ic
   kForces = 8u,   // RNEA body forces f = I (A − a_g) + V ×* I V, gravity folded in
 };
 
 // Body inertia about the world origin: c = o + R c_b, I_O = R I_c Rᵀ + m (|c|² 1 − c cᵀ).
 // Only the 6 distinct entries are formed; a diagonal I_c (common in URDFs)
 // gives R I_c Rᵀ = Σ_k I_kk r_k r_kᵀ with r_k the columns of R.
+// Also returns the CoM c and R I_c Rᵀ (about the CoM, world axes) for the forces.
 template <class Robot>
 inline void bodyInertiaWorld(const Data<Robot>& d, int i, const Eigen::Matrix3d& R,
-                             const Eigen::Vector3d& o, SpatialInertia& I) noexcept {
+                             const Eigen::Vector3d& o, SpatialInertia& I, Eigen::Vector3d& c,
+                             Eigen::Matrix3d& Icw) noexcept {
   const double m = d.body_mass[i];
-  const Eigen::Vector3d c = o + R * d.body_com[i];
+  c = o + R * d.body_com[i];
   I.m = m;
   I.h = m * c;
   Eigen::Matrix3d RI;  // R I_c, column k = R I_c e_k
@@ -57,6 +59,7 @@ inline void bodyInertiaWorld(const Data<Robot>& d, int i, const Eigen::Matrix3d&
   const double xy = RI(0, 0) * R(1, 0) + RI(0, 1) * R(1, 1) + RI(0, 2) * R(1, 2);
   const double xz = RI(0, 0) * R(2, 0) + RI(0, 1) * R(2, 1) + RI(0, 2) * R(2, 2);
   const double yz = RI(1, 0) * R(2, 0) + RI(1, 1) * R(2, 1) + RI(1, 2) * R(2, 2);
+  Icw << xx, xy, xz, xy, yy, yz, xz, yz, zz;
   I.I(0, 0) = xx + mcc - I.h.x() * c.x();
   I.I(1, 1) = yy + mcc - I.h.y() * c.y();
   I.I(2, 2) = zz + mcc - I.h.z() * c.z();
@@ -92,13 +95,24 @@ inline void forwardPass(Data<Robot>& d, const typename Data<Robot>::VectorQ& q,
   static_assert(!accel || motion, "q̈ needs the velocities");
   std::array<Vector6, Data<Robot>::nb>& Aout = accel ? d.Aq : d.A;
 
-  // f = I (A − a_g) + V ×* I V with a_g = [0 0 −g; 0] (gravity folded in).
-  const auto bodyForce = [](const SpatialInertia& I, const Vector6& V, const Vector6& A) {
-    Vector6 Ag = Vector6::Zero();
-    if constexpr (motion) Ag = A;
-    Ag[2] += kGravity;
-    Vector6 f = applyInertia(I, Ag);
-    if constexpr (motion) f += crossForce(V, applyInertia(I, V));
+  // f = I (A − a_g) + V ×* I V with a_g = [0 0 −g; 0] (gravity folded in),
+  // evaluated as Newton-Euler about the CoM c (fewer products than the 6D form):
+  // F = m (p̈_c − a_g), n = I_c α + ω × I_c ω + c × F, with the classical CoM
+  // acceleration p̈_c = a_O + α × c + ω × ṗ_c and ṗ_c = v_O + ω × c.
+  const auto bodyForce = [](double m, const Eigen::Vector3d& c, const Eigen::Matrix3d& Icw,
+                            const Vector6& V, const Vector6& A) {
+    Eigen::Vector3d F(0.0, 0.0, m * kGravity);
+    Vector6 f;
+    if constexpr (motion) {
+      const Eigen::Vector3d w = V.tail<3>();
+      const Eigen::Vector3d alpha = A.tail<3>();
+      const Eigen::Vector3d vc = V.head<3>() + w.cross(c);
+      F += m * (A.head<3>() + alpha.cross(c) + w.cross(vc));
+      f.tail<3>() = Icw * alpha + w.cross(Icw * w) + c.cross(F);
+    } else {
+      f.tail<3>() = c.cross(F);
+    }
+    f.head<3>() = F;
     return f;
   };
 
@@ -119,10 +133,10 @@ inline void forwardPass(Data<Robot>& d, const typename Data<Robot>::VectorQ& q,
       Aout[0] = A;
     }
     if constexpr (inertia) {
-      SpatialInertia I;
-      bodyInertiaWorld(d, 0, R, o, I);
-      d.Ib[0] = I;
-      if constexpr (forces) d.f[0] = bodyForce(I, V, A);
+      Eigen::Vector3d c;
+      Eigen::Matrix3d Icw;
+      bodyInertiaWorld(d, 0, R, o, d.Ic[0], c, Icw);
+      if constexpr (forces) d.f[0] = bodyForce(d.body_mass[0], c, Icw, V, A);
     }
   }
 
@@ -167,10 +181,10 @@ inline void forwardPass(Data<Robot>& d, const typename Data<Robot>::VectorQ& q,
       A = Aout[i];
     }
     if constexpr (inertia) {
-      SpatialInertia I;
-      bodyInertiaWorld(d, i, d.oR[i], d.op[i], I);
-      d.Ib[i] = I;
-      if constexpr (forces) d.f[i] = bodyForce(I, V, A);
+      Eigen::Vector3d c;
+      Eigen::Matrix3d Icw;
+      bodyInertiaWorld(d, i, d.oR[i], d.op[i], d.Ic[i], c, Icw);
+      if constexpr (forces) d.f[i] = bodyForce(d.body_mass[i], c, Icw, V, A);
     }
   }
 }

@@ -348,7 +348,8 @@ TYPED_TEST(ModelProperties, RobotDynamicsMatchesFreeFunctions) {
       EXPECT_TRUE(near(dyn.J(k), J, kTol));
       EXPECT_TRUE(near(dyn.dJv(k), hm::frameBiasAcceleration(this->d, fr[k]), kTol));
       EXPECT_TRUE(near(dyn.velocity(k), hm::frameVelocity(this->d, fr[k]), kTol));
-      EXPECT_TRUE(near(dyn.placement(k).matrix(), hm::framePlacement(this->d, fr[k]).matrix(), kTol));
+      EXPECT_TRUE(
+          near(dyn.placement(k).matrix(), hm::framePlacement(this->d, fr[k]).matrix(), kTol));
     }
   }
 }
