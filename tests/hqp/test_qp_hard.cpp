@@ -295,6 +295,24 @@ TEST(QpHard, NonFiniteInputIsNumericalFailure) {
   const auto s = qp.solve(false);
   EXPECT_EQ(str(s), "NumericalFailure");
   EXPECT_TRUE(qp.x().allFinite());
+  // NaN in A, in a constraint row, in a bound: rejected as well.
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  qp.b() << 1, 1;
+  qp.A()(1, 0) = nan;
+  EXPECT_EQ(str(qp.solve(false)), "NumericalFailure");
+  qp.A().setIdentity();
+  EXPECT_EQ(str(qp.solve(false)), "Optimal");
+  qp.resize(2, 2, 0, 1);
+  qp.A().setIdentity();
+  qp.b() << 1, 1;
+  qp.C() << 1, nan;
+  qp.lower() << 0;
+  qp.upper() << 1;
+  EXPECT_EQ(str(qp.solve(false)), "NumericalFailure");
+  EXPECT_TRUE(qp.x().allFinite());
+  qp.C() << 1, 0;
+  qp.upper() << nan;
+  EXPECT_EQ(str(qp.solve(false)), "NumericalFailure");
 }
 
 TEST(QpHard, HessianForm) {

@@ -173,6 +173,45 @@ TYPED_TEST(ModelProperties, GravityIsPotentialGradient) {
   }
 }
 
+// h(q, v) by virtual work, independent of the recursions: with q̈ = 0 every
+// body follows q(t) = q ⊕ v t; its CoM acceleration p̈_c and angular
+// acceleration ω̇ come from nested central differences of the transform chain
+// (inner step 1e-5 for velocities, outer 1e-4 for accelerations: error ~1e-7),
+// the wrench it needs is F = m (p̈_c − g), N = I ω̇ + ω × I ω about the CoM, and
+// h_k = Σ_i (F_i · ∂ṗ_c,i/∂v_k + N_i · ∂ω_i/∂v_k) with those derivatives again
+// by differences along integrate(q, e_k, ±1e-5). Holds for any base (power equivalence).
+TYPED_TEST(ModelProperties, NonLinearEffectsByVirtualWork) {
+  using R = TypeParam;
+  constexpr double kOuter = 1e-4;
+  constexpr double kInner = 1e-5;
+  for (int s = 0; s < kStates / 4; ++s) {
+    const auto q = this->q();
+    const auto v = this->v();
+    const auto bp = model_test::fdBodyMotion<R>(hm::integrate<R>(q, v, kOuter), v, kInner);
+    const auto bm = model_test::fdBodyMotion<R>(hm::integrate<R>(q, v, -kOuter), v, kInner);
+    const auto b0 = model_test::fdBodyMotion<R>(q, v, kInner);
+    std::array<Vector6d, R::nb> wrench;  // [F; N] about each body's CoM
+    for (int i = 0; i < R::nb; ++i) {
+      const double m = R::bodies[static_cast<std::size_t>(i)].mass;
+      const Eigen::Matrix3d Rw = b0.X[i].linear();
+      const Eigen::Matrix3d Iw = Rw * model_test::bodyInertiaAtCom<R>(i) * Rw.transpose();
+      const Eigen::Vector3d ac = (bp.vc[i] - bm.vc[i]) / (2 * kOuter);
+      const Eigen::Vector3d wd = (bp.w[i] - bm.w[i]) / (2 * kOuter);
+      const Eigen::Vector3d w = b0.w[i];
+      wrench[i] << m * (ac + Eigen::Vector3d(0.0, 0.0, 9.81)), Iw * wd + w.cross(Iw * w);
+    }
+    VecV<R> h_ref = VecV<R>::Zero();
+    for (int k = 0; k < R::nv; ++k) {
+      const auto dk = model_test::fdBodyMotion<R>(q, VecV<R>::Unit(k), kInner);
+      for (int i = 0; i < R::nb; ++i) {
+        h_ref[k] += wrench[i].template head<3>().dot(dk.vc[i]) +
+                    wrench[i].template tail<3>().dot(dk.w[i]);
+      }
+    }
+    EXPECT_TRUE(near(VecV<R>(hm::nonLinearEffects(this->d, q, v)), h_ref, 1e-5));
+  }
+}
+
 // Power balance vᵀ Ṁ v = 2 vᵀ (h − g), Ṁ by central differences along integrate.
 TYPED_TEST(ModelProperties, PowerBalance) {
   using R = TypeParam;
