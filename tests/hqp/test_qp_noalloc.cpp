@@ -43,14 +43,7 @@ TEST(QpNoAlloc, SolveDoesNotAllocate) {
     const bool infeasible = k % 5 == 4;
     const auto p = hqp::testing::makeRandomQp(rng, 30, 15, 6, 48, k % 2 ? 10 : -1, 0.5, false,
                                               infeasible);
-    qp.resize(30, 15, 6, 48);
-    qp.A() = p.A;
-    qp.b() = p.b;
-    qp.E() = p.E;
-    qp.e() = p.e;
-    qp.C() = p.C;
-    qp.lower() = p.lower;
-    qp.upper() = p.upper;
+    hqp::testing::loadInto(qp, p);
     const Qp::VectorX hint = p.x0;
     g_news = 0;
     g_counting = true;

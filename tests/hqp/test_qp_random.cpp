@@ -13,19 +13,6 @@ namespace {
 using SmallQp = hqp::ActiveSetQp<8, 12, 4, 10>;
 using LargeQp = hqp::ActiveSetQp<30, 30, 10, 60>;
 
-template <class Qp>
-void load(Qp& qp, const hqp::testing::RandomQp& p) {
-  qp.resize(static_cast<int>(p.A.cols()), static_cast<int>(p.A.rows()),
-            static_cast<int>(p.E.rows()), static_cast<int>(p.C.rows()));
-  qp.A() = p.A;
-  qp.b() = p.b;
-  qp.E() = p.E;
-  qp.e() = p.e;
-  qp.C() = p.C;
-  qp.lower() = p.lower;
-  qp.upper() = p.upper;
-}
-
 struct KktError {
   double stationarity = 0, primal = 0, dual = 0, complementarity = 0;
 };
@@ -90,7 +77,7 @@ TEST(QpRandom, SmallProblemsMatchBruteForce) {
     // Keep the enumeration small: at most 5 rows bounded on both sides on average.
     const auto p = hqp::testing::makeRandomQp(rng, n, m, me, mi, rank_a, 0.35, redundant,
                                               infeasible);
-    load(qp, p);
+    hqp::testing::loadInto(qp, p);
     const hqp::QpStatus st = qp.solve(false);
     const auto ref = hqp::testing::bruteForceQp(p.A, p.b, p.E, p.e, p.C, p.lower, p.upper);
     ASSERT_TRUE(qp.x().allFinite()) << trial;
@@ -129,7 +116,7 @@ TEST(QpRandom, LargeProblemsSatisfyKkt) {
     const int mi = std::uniform_int_distribution<int>(0, 60 - me)(rng);
     const int rank_a = U100(rng) < 50 ? std::min(m, 20) - 3 : -1;
     const auto p = hqp::testing::makeRandomQp(rng, n, m, me, mi, rank_a, 0.5);
-    load(qp, p);
+    hqp::testing::loadInto(qp, p);
     ASSERT_EQ(qp.solve(false), hqp::QpStatus::Optimal) << trial;
     max_iter = std::max(max_iter, qp.iterations());
     const KktError k = kkt(qp, p);

@@ -11,19 +11,6 @@ namespace {
 
 using Qp = hqp::ActiveSetQp<30, 15, 6, 48>;
 
-template <class Q>
-void load(Q& qp, const hqp::testing::RandomQp& p) {
-  qp.resize(static_cast<int>(p.A.cols()), static_cast<int>(p.A.rows()),
-            static_cast<int>(p.E.rows()), static_cast<int>(p.C.rows()));
-  qp.A() = p.A;
-  qp.b() = p.b;
-  qp.E() = p.E;
-  qp.e() = p.e;
-  qp.C() = p.C;
-  qp.lower() = p.lower;
-  qp.upper() = p.upper;
-}
-
 TEST(QpWarm, PerturbedSequencesMatchColdStarts) {
   std::mt19937 rng(99);
   std::normal_distribution<double> N(0.0, 1.0);
@@ -47,8 +34,8 @@ TEST(QpWarm, PerturbedSequencesMatchColdStarts) {
       p.lower += shift;
       p.upper += shift;
       p.e = p.E * p.x0;
-      load(warm, p);
-      load(cold, p);
+      hqp::testing::loadInto(warm, p);
+      hqp::testing::loadInto(cold, p);
       const auto sw = warm.solve(true);
       const auto sc = cold.solve(false);
       ASSERT_EQ(sc, hqp::QpStatus::Optimal) << seq << " " << step;
@@ -76,8 +63,8 @@ TEST(QpWarm, StaleWorkingSetAfterLargeChangeIsRepaired) {
     // Unrelated problems one after another: the previous working set is useless
     // (often infeasible or dependent) and must be dropped.
     const auto p = hqp::testing::makeRandomQp(rng, 30, 15, 6, 48, -1, 0.5);
-    load(warm, p);
-    load(cold, p);
+    hqp::testing::loadInto(warm, p);
+    hqp::testing::loadInto(cold, p);
     ASSERT_EQ(warm.solve(true), hqp::QpStatus::Optimal);
     ASSERT_EQ(cold.solve(false), hqp::QpStatus::Optimal);
     EXPECT_LE((warm.x() - cold.x()).cwiseAbs().maxCoeff(), 1e-9);
@@ -90,8 +77,8 @@ TEST(QpWarm, FeasibleHintSkipsPhaseOneAndGivesSameAnswer) {
   a.settings().max_iterations = b.settings().max_iterations = 500;
   for (int k = 0; k < 20; ++k) {
     const auto p = hqp::testing::makeRandomQp(rng, 30, 15, 6, 48, -1, 0.5);
-    load(a, p);
-    load(b, p);
+    hqp::testing::loadInto(a, p);
+    hqp::testing::loadInto(b, p);
     const Qp::VectorX hint = p.x0;  // feasible by construction
     ASSERT_EQ(a.solve(hint, false), hqp::QpStatus::Optimal);
     ASSERT_EQ(b.solve(false), hqp::QpStatus::Optimal);

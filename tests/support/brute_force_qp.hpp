@@ -168,6 +168,20 @@ struct RandomQp {
   Eigen::VectorXd x0;  // a point that satisfies the constraints (when built feasible)
 };
 
+// Copies a problem (any struct with A, b, E, e, C, lower, upper) into an ActiveSetQp-like solver.
+template <class Qp, class Problem>
+void loadInto(Qp& qp, const Problem& p) {
+  qp.resize(static_cast<int>(p.A.cols()), static_cast<int>(p.A.rows()),
+            static_cast<int>(p.E.rows()), static_cast<int>(p.C.rows()));
+  qp.A() = p.A;
+  qp.b() = p.b;
+  qp.E() = p.E;
+  qp.e() = p.e;
+  qp.C() = p.C;
+  qp.lower() = p.lower;
+  qp.upper() = p.upper;
+}
+
 // rank_a < 0: full rank. two_sided: fraction of inequality rows bounded on both
 // sides; the rest get one side. Bounds are placed around C x0 with random slack,
 // some exactly at C x0 (many active at a point), so the problem is feasible unless
