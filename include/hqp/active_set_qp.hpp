@@ -54,16 +54,15 @@ class ActiveSetQp {
     return max_rows == 1 && MaxN != 1 ? Eigen::RowMajor : Eigen::ColMajor;
   }
 
-  using MatrixA =
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, storage(MaxRows), MaxRows, MaxN>;
-  using MatrixE =
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, storage(MaxEq), MaxEq, MaxN>;
-  using MatrixC =
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, storage(MaxIneq), MaxIneq, MaxN>;
+  // A capacity of 0 is stored as 1 (Eigen mis-sizes max-size-0 storage); the
+  // run-time sizes are still bounded by MaxRows, MaxEq, MaxIneq.
+  using MatrixA = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, storage(MR), MR, MaxN>;
+  using MatrixE = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, storage(ME), ME, MaxN>;
+  using MatrixC = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, storage(MI), MI, MaxN>;
   using VectorX = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, MaxN, 1>;
-  using VectorRows = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, MaxRows, 1>;
-  using VectorEq = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, MaxEq, 1>;
-  using VectorIneq = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, MaxIneq, 1>;
+  using VectorRows = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, MR, 1>;
+  using VectorEq = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, ME, 1>;
+  using VectorIneq = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, MI, 1>;
 
   explicit ActiveSetQp(const QpSettings& settings = {}) : settings_(settings) {
     resize(0, 0, 0, 0);
