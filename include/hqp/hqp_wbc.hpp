@@ -121,7 +121,7 @@ class HqpWbc {
   // largest level: Nx variables, the most task rows of any level, all constraint rows. One
   // type instead of one per level keeps compile times down (each ActiveSetQp instantiation
   // costs ~15 s of compiler time); the storage difference is a few kB per level.
-  using Qp = ActiveSetQp<Nx, capacity(max_task_rows), 2, capacity(total_constraint_rows)>;
+  using Qp = ActiveSetQp<Nx, capacity(max_task_rows), 0, capacity(total_constraint_rows)>;
   template <int P>
   using LevelQp = std::conditional_t<(constraint_offset[P + 1] > 0), Qp, detail::NoQp>;
   // Slack levels (Level<..., true>): minimal violation of one level's own rows, variables
@@ -131,7 +131,7 @@ class HqpWbc {
   static constexpr int max_slack_rows = detail::maxSlackRows<Levels...>();
   using SlackQp = std::conditional_t<
       has_slack_levels,
-      ActiveSetQp<Nx + capacity(max_slack_rows), capacity(max_slack_rows), 2,
+      ActiveSetQp<Nx + capacity(max_slack_rows), capacity(max_slack_rows), 0,
                   capacity(total_constraint_rows)>,
       detail::NoQp>;
 

@@ -53,7 +53,7 @@ class WqpWbc {
 
   using VectorX = Eigen::Matrix<double, Nx, 1>;
   using Result = WqpResult<Nx, num_levels, max_active>;
-  using Qp = ActiveSetQp<Nx, capacity(total_task_rows), 2, capacity(total_constraint_rows)>;
+  using Qp = ActiveSetQp<Nx, capacity(total_task_rows), 0, capacity(total_constraint_rows)>;
   template <int P>
   using LevelType = std::tuple_element_t<P, std::tuple<Levels...>>;
 
