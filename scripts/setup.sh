@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs every Debian 12 package the build, tests, benchmarks and demo need.
 # Idempotent: skips the install when every package is already present.
+# --demo adds what only the MuJoCo demo needs (ffmpeg for the MP4).
 set -euo pipefail
 
 PACKAGES=(
@@ -8,10 +9,13 @@ PACKAGES=(
   libeigen3-dev liburdfdom-dev
   libmujoco-dev libgl-dev libegl-dev libqhull-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
+  libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libnlopt-cxx-dev
   liblodepng-dev
-  python3 python3-numpy python3-matplotlib
+  python3 python3-numpy python3-scipy python3-matplotlib
 )
+if [ "${1:-}" = "--demo" ]; then
+  PACKAGES+=(ffmpeg)
+fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do

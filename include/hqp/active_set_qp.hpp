@@ -161,6 +161,13 @@ class ActiveSetQp {
   QpStatus iterate(bool phase1);       // the active-set loop on the current phase
   double maxViolation(const VecN& v);  // scaled, over E and C (uses ev_, cx_)
   void givens(int p, double c, double s);    // Q, G columns p, p+1
+  // Q is kept implicit (Q = H_0 ⋯ H_{k−1}, the reflectors of the rows added since the
+  // phase started) until the first working-set change of iterate(): a warm start whose
+  // working set is still optimal never forms the n × n matrix.
+  void applyReflector(int j, VecN& v) const;  // v ← H_j v
+  void applyQ(VecN& v) const;                 // v ← Q v (v holds nv_ entries)
+  void ensureExplicit();                      // Q_ ← H_0 ⋯ H_{k−1}
+  void minNormPoint(VecN& out);               // Q₁ R⁻ᵀ rhs (uses y_)
   // Two-sided structure of G_Z = Uᵀ A Z = [T 0; 0 0], T upper triangular
   // (r = min(m, nz)): see docs/active-set-qp.md, "Incremental factorizations".
   void colRot(int i, int j, double c, double s);  // Q, G columns i, j
@@ -203,6 +210,9 @@ class ActiveSetQp {
   Eigen::Matrix<int, MI, 1> in_ws_;
   Eigen::Matrix<double, NV, 1> rhs_;
   MatNN Q_, R_;
+  bool qexplicit_ = false;  // Q_ is valid; otherwise Q is the product of Hv_, htau_
+  MatNN Hv_;                // reflector j: essential part in Hv_(j+1:, j)
+  VecN htau_;
   Eigen::Matrix<double, MR, NV, Eigen::RowMajor> AQ_;  // G = Uᵀ A Q (U: row rotations, in structured mode)
   Eigen::Matrix<double, MR, 1> cU_;       // c̃ = Uᵀ b
   bool trap_ = false;                     // G_Z has the [T 0; 0 0] structure
@@ -267,11 +277,61 @@ void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::givens(int p, double c, double 
 }
 
 template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::applyReflector(int j, VecN& v) const {
+  const double tau = htau_(j);
+  if (tau == 0.0) return;
+  const int len = nv_ - j - 1;
+  const double s = tau * (v(j) + Hv_.col(j).segment(j + 1, len).dot(v.segment(j + 1, len)));
+  v(j) -= s;
+  v.segment(j + 1, len) -= s * Hv_.col(j).segment(j + 1, len);
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::applyQ(VecN& v) const {
+  if (qexplicit_) {
+    const VecN t = v;
+    v.head(nv_).noalias() = Q_.topLeftCorner(nv_, nv_) * t.head(nv_);
+  } else {
+    for (int j = k_ - 1; j >= 0; --j) applyReflector(j, v);
+  }
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::ensureExplicit() {
+  if (qexplicit_) return;
+  // Backward accumulation: H_j only touches rows/columns ≥ j of H_{j+1} ⋯ H_{k−1}.
+  Q_.topLeftCorner(nv_, nv_).setIdentity();
+  for (int j = k_ - 1; j >= 0; --j) {
+    const int len = nv_ - j;
+    if (len > 1 && htau_(j) != 0.0)
+      Q_.block(j, j, len, len)
+          .applyHouseholderOnTheLeft(Hv_.col(j).segment(j + 1, len - 1), htau_(j), work_.data());
+  }
+  qexplicit_ = true;
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::minNormPoint(VecN& out) {
+  for (int i = 0; i < k_; ++i) {  // Rᵀ y = rhs
+    // dot products (vectorized), not a serial chain of scalar updates
+    y_(i) = (rhs_(i) - R_.col(i).head(i).dot(y_.head(i))) / R_(i, i);
+  }
+  out.head(k_) = y_.head(k_);
+  out.segment(k_, nv_ - k_).setZero();
+  applyQ(out);
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
 bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addRowVector(double rhs) {
   if (k_ >= nv_) return false;
   // w = Qᵀ a; the row is independent of K iff w(k:) = Zᵀ a ≠ 0.
   const int nz = nv_ - k_;
-  w_.head(nv_).noalias() = Q_.topLeftCorner(nv_, nv_).transpose() * a_.head(nv_);
+  if (qexplicit_) {
+    w_.head(nv_).noalias() = Q_.topLeftCorner(nv_, nv_).transpose() * a_.head(nv_);
+  } else {
+    w_.head(nv_) = a_.head(nv_);
+    for (int j = 0; j < k_; ++j) applyReflector(j, w_);
+  }
   const double an2 = a_.head(nv_).squaredNorm();
   const double wn2 = w_.segment(k_, nz).squaredNorm();
   const double tol = settings_.rank_tol;
@@ -284,13 +344,17 @@ bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addRowVector(double rhs) {
   double tau = 0.0, beta = 0.0;
   w_.segment(k_, nz).makeHouseholderInPlace(tau, beta);
   if (nz > 1) {
-    Q_.block(0, k_, nv_, nz)
-        .applyHouseholderOnTheRight(w_.segment(k_ + 1, nz - 1), tau, work_.data());
-    if (mc_ > 0)
-      AQ_.block(0, k_, mc_, nz)
+    if (qexplicit_) {
+      Q_.block(0, k_, nv_, nz)
           .applyHouseholderOnTheRight(w_.segment(k_ + 1, nz - 1), tau, work_.data());
+    } else {
+      Hv_.col(k_).segment(k_ + 1, nz - 1) = w_.segment(k_ + 1, nz - 1);
+      htau_(k_) = tau;
+    }
+    if (mc_ > 0) detail::reflectRows(w_.segment(k_ + 1, nz - 1), tau, AQ_.block(0, k_, mc_, nz));
   } else {
     beta = w_(k_);
+    htau_(k_) = 0.0;
   }
   R_.col(k_).head(k_) = w_.head(k_);
   R_(k_, k_) = beta;
@@ -528,7 +592,7 @@ void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::startPhase(bool phase1) {
   // Q = I, G = A (phase 1: A = e_tᵀ, b = 0 for ½t²), c̃ = b. R is written column by
   // column as rows are added.
   nv_ = phase1 ? n_ + 1 : n_;
-  Q_.topLeftCorner(nv_, nv_).setIdentity();
+  qexplicit_ = false;  // k = 0: Q = I
   if (phase1) {
     mc_ = 1;
     AQ_.row(0).head(nv_).setZero();
@@ -565,16 +629,7 @@ bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addEqualities() {
   nw_ = nw_keep;
   // Consistency of the dependent rows: residual at the minimum-norm point.
   if (neq_ == me_) return true;
-  for (int i = 0; i < neq_; ++i) {  // Rᵀ y = rhs
-    double s = rhs_(i);
-    for (int j = 0; j < i; ++j) s -= R_(j, i) * y_(j);
-    y_(i) = s / R_(i, i);
-  }
-  for (int r = 0; r < n_; ++r) {  // scratch: xs_ (xc_ holds the iterate)
-    double s = 0.0;
-    for (int i = 0; i < neq_; ++i) s += Q_(r, i) * y_(i);
-    xs_(r) = s;
-  }
+  minNormPoint(xs_);  // scratch: xs_ (xc_ holds the iterate)
   for (int i = 0; i < me_; ++i) {
     double s = -es_(i);
     for (int c = 0; c < n_; ++c) s += Es_(i, c) * xs_(c);
@@ -587,9 +642,8 @@ template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
 bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::subproblem() {
   // x_p = Q₁ R⁻ᵀ rhs: the minimum-norm point of K x = rhs.
   for (int i = 0; i < k_; ++i) {
-    double s = rhs_(i);
-    for (int j = 0; j < i; ++j) s -= R_(j, i) * y_(j);
-    y_(i) = s / R_(i, i);
+    // dot products (vectorized), not a serial chain of scalar updates
+    y_(i) = (rhs_(i) - R_.col(i).head(i).dot(y_.head(i))) / R_(i, i);
   }
   const int nz = nv_ - k_;
   // r = b − A x_p = b − (A Q₁) y ;  M = A Z = (A Q)(:, k:)
@@ -607,8 +661,8 @@ bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::subproblem() {
         for (int i = 0; i < r; ++i) done = done && std::abs(AQ_(i, k_ + i)) > tol;
         if (done) {
           for (int i = r - 1; i >= 0; --i) {
-            double sum = r_(i);
-            for (int j = i + 1; j < r; ++j) sum -= AQ_(i, k_ + j) * p_(j);
+            const double sum =
+                r_(i) - AQ_.row(i).segment(k_ + i + 1, r - i - 1).dot(p_.segment(i + 1, r - i - 1));
             p_(i) = sum / AQ_(i, k_ + i);
           }
           p_.segment(r, nz - r).setZero();
@@ -623,7 +677,12 @@ bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::subproblem() {
   if (mc_ == 0) p_.head(nz).setZero();
   // x* = Q [y; p]  (x_p ⊥ range(Z), so the min-norm p gives the min-norm x*).
   y_.segment(k_, nz) = p_.head(nz);
-  xs_.head(nv_).noalias() = Q_.topLeftCorner(nv_, nv_) * y_.head(nv_);
+  if (qexplicit_) {
+    xs_.head(nv_).noalias() = Q_.topLeftCorner(nv_, nv_) * y_.head(nv_);
+  } else {
+    xs_.head(nv_) = y_.head(nv_);
+    applyQ(xs_);
+  }
   return xs_.head(nv_).allFinite();
 }
 
@@ -639,10 +698,11 @@ bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::multipliers() {
   } else {
     y_.head(k_).setZero();
   }
+  // R λ = y by columns (axpy, vectorized; R is column-major).
+  lam_.head(k_) = y_.head(k_);
   for (int i = k_ - 1; i >= 0; --i) {
-    double s = y_(i);
-    for (int j = i + 1; j < k_; ++j) s -= R_(i, j) * lam_(j);
-    lam_(i) = s / R_(i, i);
+    lam_(i) /= R_(i, i);
+    lam_.head(i) -= lam_(i) * R_.col(i).head(i);
   }
   return lam_.head(k_).allFinite();
 }
@@ -725,6 +785,7 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
       if (iterations_ >= settings_.max_iterations) return QpStatus::IterationLimit;
       ++iterations_;
       zero_steps = alpha * dn == 0.0 ? zero_steps + 1 : 0;
+      ensureExplicit();
       // A row numerically dependent on K cannot be held; skip it until K changes.
       if (!trap_ && ++changes_ >= kEstablishAfter) establishStructure();
       skip_row = addRow(block, block_upper) ? -1 : block;
@@ -755,6 +816,7 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
     if (drop < 0) return QpStatus::Optimal;
     if (iterations_ >= settings_.max_iterations) return QpStatus::IterationLimit;
     ++iterations_;
+    ensureExplicit();
     if (!trap_ && ++changes_ >= kEstablishAfter) establishStructure();
     removeRow(neq_ + drop);
     skip_row = -1;
@@ -833,16 +895,7 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::solveImpl(const VectorX* x_
   }
   if (!started) {
     // Minimum-norm point of E x = e (the subproblem with A = 0 would do the same).
-    for (int i = 0; i < neq_; ++i) {
-      double s = rhs_(i);
-      for (int j = 0; j < i; ++j) s -= R_(j, i) * y_(j);
-      y_(i) = s / R_(i, i);
-    }
-    for (int r = 0; r < n_; ++r) {
-      double s = 0.0;
-      for (int i = 0; i < neq_; ++i) s += Q_(r, i) * y_(i);
-      xc_(r) = s;
-    }
+    minNormPoint(xc_);
     const double t0 = maxViolation(xc_);
     if (t0 > settings_.feasibility_tol) {
       // Phase 1: min ½t² s.t. Ĉx − t ≤ û, Ĉx + t ≥ l̂, E x = e, from (x_E, t0).

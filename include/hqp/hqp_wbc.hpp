@@ -171,10 +171,18 @@ class HqpWbc {
     result_.status = QpStatus::Optimal;
     result_.failed_level = -1;
     x_.setZero();
-    Z_.setIdentity(Nx, Nx);
     n_ = Nx;
     if constexpr (total_constraint_rows > 0)
       Dnorm_.head(total_constraint_rows) = D_.topRows(total_constraint_rows).rowwise().norm();
+    // Working copy of all rows in the reduced coordinates of the current level (Z_{−1} = I),
+    // and the reduced right-hand sides b − A x*, D x* (x*_{−1} = 0).
+    W_.template topRows<total_task_rows>() = A_.template topRows<total_task_rows>();
+    if constexpr (total_constraint_rows > 0) {
+      W_.template middleRows<total_constraint_rows>(total_task_rows) =
+          D_.template topRows<total_constraint_rows>();
+      dx_.setZero();
+    }
+    bt_ = b_;
     if (!inputValid()) {
       for (auto& lr : result_.levels) lr = HqpLevelResult<max_active>{};
       result_.status = QpStatus::NumericalFailure;
@@ -184,6 +192,7 @@ class HqpWbc {
       return result_.status;
     }
     solveLevels(std::make_index_sequence<sizeof...(Levels)>{});
+    reconstructX();
     result_.x = x_;
     return result_.status;
   }
@@ -197,7 +206,6 @@ class HqpWbc {
   QpStatus status() const { return result_.status; }
 
  private:
-  using MatrixZ = MaxMatrix<Nx, Nx>;
   using MatrixM = MaxMatrix<capacity(max_task_rows), Nx>;
   using VectorM = MaxVector<capacity(max_task_rows)>;
   using VectorU = MaxVector<Nx>;
@@ -250,6 +258,25 @@ class HqpWbc {
   // Row norms below this count as zero rows when scaling constraint violations.
   static double rowScale(double norm) { return norm > 1e-300 ? norm : 1.0; }
 
+  // x* = Σ_p Z_{p−1} Q_p u'_p with Z_p = Z_{p−1} Q_p E_p, E_p = [0; I] (the null-space
+  // columns): x* = Q_0 (u'_0 + E_0 Q_1 (u'_1 + E_1 Q_2 (…))), evaluated from the last level up
+  // with each level's stored reflectors (vector work only; no Z is ever formed).
+  void reconstructX() {
+    v_.resize(0);
+    for (int p = num_levels - 1; p >= 0; --p) {
+      const std::size_t ps = static_cast<std::size_t>(p);
+      const int n = var_[ps];
+      if (n == 0) continue;
+      const int k = rank_[ps];
+      q_ = up_[ps];
+      if (n - k > 0 && v_.size() == n - k) q_.tail(n - k) += v_;
+      ns_[ps].applyQOnTheLeft(q_);
+      v_ = q_;
+    }
+    if (v_.size() == Nx) x_ = v_;
+    else x_.setZero();
+  }
+
   template <int P>
   void solveLevel() {
     constexpr int r = LevelType<P>::task_rows;
@@ -257,36 +284,41 @@ class HqpWbc {
     constexpr int c0 = constraint_offset[P];
     constexpr int c = constraint_offset[P + 1];
     constexpr int own = c - c0;
+    // Rows below this level's tasks (lower tasks, then all constraint rows) in W_.
+    constexpr int below = total_task_rows + total_constraint_rows - (t0 + r);
     auto& lr = result_.levels[P];
     lr = HqpLevelResult<max_active>{};
     const int n = n_;
+    const int col0 = Nx - n;  // W_ columns [col0, Nx) hold the rows times Z_{p−1}
     lr.variables = n;
+    var_[P] = n;
+    rank_[P] = 0;
 
     if (n == 0) {
       // Nothing left to move: only check the level's own constraints at x*.
       if constexpr (own > 0) ownRowsWithoutFreedom<P>(lr);
-      finishLevel<P>(lr);
+      finishLevel<P>(lr, -bt_.template segment<r>(t0));
       return;
     }
 
     // Â_p = W^½ A_p Z_{p−1} (r x n) and its null space (eq. 4).
-    const auto Ap = A_.template middleRows<r>(t0);
     const auto sw = w_.template segment<r>(t0).cwiseSqrt();
-    M_.resize(r, n);
-    if constexpr (P == 0) {
-      M_ = Ap;  // Z_0 = I
-    } else {
-      M_.noalias() = Ap * Z_;
-    }
+    M_ = W_.block(t0, col0, r, n);
     M_.array().colwise() *= sw.array();
-    const double scale =
-        std::sqrt((Ap.rowwise().squaredNorm().array() * w_.template segment<r>(t0).array()).maxCoeff());
-    ns_.compute(M_, settings_.rank_tol * scale);
-    const int k = ns_.rank();
-    ZQ_ = Z_;
-    ns_.applyQOnTheRight(ZQ_);      // x = x*_{p−1} + ZQ u', u' = [row-space part; null part]
-    ns_.rotatedMatrix(Aq_);         // Â_p Q, truncated to rank k
-    bq_.noalias() = b_.template segment<r>(t0) - Ap * x_;
+    const double scale = std::sqrt((A_.template middleRows<r>(t0).rowwise().squaredNorm().array() *
+                                    w_.template segment<r>(t0).array())
+                                       .maxCoeff());
+    auto& ns = ns_[P];
+    ns.compute(M_, settings_.rank_tol * scale);
+    const int k = ns.rank();
+    // Every row below (lower tasks, all constraints) into the coordinates u = Q u':
+    // u' = [row-space part (k); null part (n − k)], so Z_p is the last n − k columns.
+    if constexpr (below > 0) {
+      auto rows_below = W_.block(t0 + r, col0, below, n);
+      ns.applyQOnTheRight(rows_below);
+    }
+    ns.rotatedMatrix(Aq_);  // Â_p Q, truncated to rank k
+    bq_ = bt_.template segment<r>(t0);
     bq_.array() *= sw.array();
     u_.setZero(n);
 
@@ -303,8 +335,7 @@ class HqpWbc {
       qp.resize(n, r, 0, c);
       qp.A() = Aq_;
       qp.b() = bq_;
-      qp.C().noalias() = D_.topRows(c) * ZQ_;
-      dx_.head(c).noalias() = D_.topRows(c) * x_;
+      qp.C() = W_.block(total_task_rows, col0, c, n);
       qp.lower() = lower_.head(c) - dx_.head(c);
       qp.upper() = upper_.head(c) - dx_.head(c);
       typename std::remove_reference_t<decltype(qp)>::VectorX hint;
@@ -352,19 +383,35 @@ class HqpWbc {
       }
     }
 
-    x_.noalias() += ZQ_ * u_;
-    Z_ = ZQ_.rightCols(n - k);  // Z_p = Z_{p−1} null(Â_p)
+    // x*_p = x*_{p−1} + Z_{p−1} Q u' (eq. 4): update the reduced right-hand sides of every
+    // row below (in the new coordinates), and the level's own residual A_p x*_p − b_p =
+    // (A_p Z_{p−1})(Q u') − (b_p − A_p x*_{p−1}) with its rows still in the old ones.
+    up_[P] = u_;
+    if constexpr (below > 0) {
+      tmp_.head(below).noalias() = W_.block(t0 + r, col0, below, n) * u_;
+      if constexpr (below > total_constraint_rows)
+        bt_.segment(t0 + r, below - total_constraint_rows) -=
+            tmp_.head(below - total_constraint_rows);
+      if constexpr (total_constraint_rows > 0)
+        dx_.head(total_constraint_rows) += tmp_.segment(below - total_constraint_rows,
+                                                        total_constraint_rows);
+    }
+    q_ = u_;
+    ns.applyQOnTheLeft(q_);
+    const Eigen::Matrix<double, r, 1> e =
+        W_.block(t0, col0, r, n) * q_ - bt_.template segment<r>(t0);
     n_ = n - k;
     lr.rank = k;
-    finishLevel<P>(lr);
+    rank_[P] = k;
+    finishLevel<P>(lr, e);
   }
 
-  template <int P>
-  void finishLevel(HqpLevelResult<max_active>& lr) {
+  // e = A_p x*_p − b_p.
+  template <int P, class Vec>
+  void finishLevel(HqpLevelResult<max_active>& lr, const Vec& e) {
     constexpr int r = LevelType<P>::task_rows;
     constexpr int t0 = task_offset[P];
     lr.null_dim = n_;
-    const auto e = (A_.template middleRows<r>(t0) * x_ - b_.template segment<r>(t0)).eval();
     lr.residual = e.squaredNorm();
     lr.objective = (e.array().square() * w_.template segment<r>(t0).array()).sum();
     noteStatus(P, lr.status);
@@ -402,11 +449,10 @@ class HqpWbc {
   }
 
   // Own bound violation Σ over rows of max(lower − d, d − upper, 0)² for d = D_own x.
-  template <int P>
-  double ownViolation(const VectorX& x) const {
+  template <int P, class Vec>
+  double ownViolation(const Vec& d) const {
     constexpr int c0 = constraint_offset[P];
     constexpr int own = LevelType<P>::constraint_rows;
-    const Eigen::Matrix<double, own, 1> d = D_.template middleRows<own>(c0) * x;
     double v = 0.0;
     for (int i = 0; i < own; ++i) {
       const double e = std::max(0.0, std::max(lower_(c0 + i) - d(i), d(i) - upper_(c0 + i)));
@@ -420,7 +466,7 @@ class HqpWbc {
   void ownRowsWithoutFreedom(HqpLevelResult<max_active>& lr) {
     constexpr int c0 = constraint_offset[P];
     constexpr int own = LevelType<P>::constraint_rows;
-    const Eigen::Matrix<double, own, 1> d = D_.template middleRows<own>(c0) * x_;
+    const Eigen::Matrix<double, own, 1> d = dx_.template segment<own>(c0);  // D_own x*
     bool feasible = true;
     for (int i = 0; i < own; ++i) {
       const double s = rowScale(D_.row(c0 + i).norm());
@@ -431,7 +477,7 @@ class HqpWbc {
     if (feasible) return;
     lr.status = QpStatus::Infeasible;
     if (slack_[P]) {
-      lr.violation = ownViolation<P>(x_);
+      lr.violation = ownViolation<P>(d);
       lr.slack_used = true;
       for (int i = 0; i < own; ++i) {
         lower_(c0 + i) = std::min(lower_(c0 + i), d(i));
@@ -501,7 +547,7 @@ class HqpWbc {
   QpTuple qps_;
   SlackQp slack_qp_;
   LeastSquares ls_;
-  NullSpace<capacity(max_task_rows), Nx> ns_;
+  std::array<NullSpace<capacity(max_task_rows), Nx>, sizeof...(Levels)> ns_{};  // per level: Q_p
   std::array<bool, sizeof...(Levels)> slack_{};
   static constexpr std::array<bool, sizeof...(Levels)> slack_capable_{
       (Levels::slack && Levels::constraint_rows > 0)...};
@@ -513,14 +559,21 @@ class HqpWbc {
   Eigen::Matrix<double, capacity(total_constraint_rows), Nx> D_ = decltype(D_)::Zero();
   VectorC lower_ = VectorC::Constant(-kInf);
   VectorC upper_ = VectorC::Constant(kInf);
-  VectorC dx_ = VectorC::Zero();  // D x*_{p−1}
+  VectorC dx_ = VectorC::Zero();  // D x*_{p−1} (all constraint rows)
+  // All task rows, then all constraint rows, times Z_{p−1} (columns [Nx − n_p, Nx)).
+  Eigen::Matrix<double, capacity(total_task_rows + total_constraint_rows), Nx> W_ =
+      decltype(W_)::Zero();
+  Eigen::Matrix<double, capacity(total_task_rows), 1> bt_ = decltype(bt_)::Zero();  // b − A x*
+  Eigen::Matrix<double, capacity(total_task_rows + total_constraint_rows), 1> tmp_ =
+      decltype(tmp_)::Zero();
   VectorC Dnorm_ = VectorC::Zero();  // row norms of D
 
   // Cascade state and scratch.
   VectorX x_ = VectorX::Zero();  // x*_p
-  MatrixZ Z_;                    // Z_p (Nx x n_p), orthonormal columns
-  MatrixZ ZQ_;                   // Z_{p−1} Q of the current level
-  int n_ = Nx;
+  int n_ = Nx;                   // columns of Z_p
+  std::array<VectorU, sizeof...(Levels)> up_{};  // u'_p of every level
+  std::array<int, sizeof...(Levels)> var_{}, rank_{};  // n and k of every level
+  VectorU q_, v_;                // Q u' / reconstruction scratch
   MatrixM M_;                    // Â_p
   MatrixM Aq_;                   // Â_p Q (truncated)
   VectorM bq_;                   // W^½ (b_p − A_p x*_{p−1})

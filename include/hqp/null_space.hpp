@@ -6,15 +6,18 @@
 // with k = rank, the first k columns of Q span the row space of M and the last n − k span
 // null(M), orthonormally. In the rotated coordinates u = Q u', M Q = [Π R₁ᵀ  0]: the task
 // only sees the first k coordinates, the rest is the null space handed to lower levels.
-// Eigen's ColPivHouseholderQR on max-size matrices works in its members' storage and its
-// Householder sequence applies with a fixed-size workspace, so nothing here allocates
-// (checked by the no-malloc tests).
+// The factorization is written here on max-size storage (Eigen's ColPivHouseholderQR was
+// a third of the hierarchy's linear algebra at these sizes, mostly its norm downdates):
+// the pivot is the largest remaining column norm, recomputed exactly at every step (no
+// downdating, so no cancellation), and it stops at the first pivot ≤ threshold, so Q is
+// the product of the k reflectors of the row space. Nothing allocates (no-malloc tests).
 
 #include <Eigen/Core>
-#include <Eigen/QR>
+#include <Eigen/Householder>
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "hqp/hqp_types.hpp"
 
@@ -25,7 +28,7 @@ template <int MaxRows, int MaxCols>
 class NullSpace {
  public:
   using Factor = MaxMatrix<capacity(MaxCols), capacity(MaxRows)>;  // storage of Mᵀ
-  using Decomposition = Eigen::ColPivHouseholderQR<Factor>;
+  using Coeffs = MaxVector<capacity(MaxRows)>;
 
   NullSpace() = default;
 
@@ -37,10 +40,44 @@ class NullSpace {
     cols_ = static_cast<int>(M.cols());
     rank_ = 0;
     if (rows_ == 0 || cols_ == 0) return;
-    qr_.compute(M.transpose());
-    const auto& R = qr_.matrixQR();
+    qr_ = M.transpose();  // cols_ x rows_
+    tau_.setZero(std::min(rows_, cols_));
+    perm_.resize(rows_);
+    for (int j = 0; j < rows_; ++j) perm_(j) = j;
     const int kmax = std::min(rows_, cols_);
-    while (rank_ < kmax && std::abs(R(rank_, rank_)) > threshold) ++rank_;
+    for (int i = 0; i < kmax; ++i) {
+      const int len = cols_ - i;
+      int jmax = i;
+      double best = -1.0;
+      for (int j = i; j < rows_; ++j) {
+        const double nj = qr_.col(j).segment(i, len).squaredNorm();
+        if (nj > best) {
+          best = nj;
+          jmax = j;
+        }
+      }
+      if (!(std::sqrt(best) > threshold)) break;  // |R_ii| would be ≤ threshold: rank = i
+      if (jmax != i) {
+        qr_.col(i).swap(qr_.col(jmax));
+        std::swap(perm_(i), perm_(jmax));
+      }
+      double tau = 0.0, beta = 0.0;
+      qr_.col(i).segment(i, len).makeHouseholderInPlace(tau, beta);
+      qr_(i, i) = beta;
+      tau_(i) = tau;
+      // H_i on the remaining columns, one dot + axpy per column: at these sizes (≤ 30 x 15)
+      // Eigen's general block update is dominated by its call overhead.
+      if (tau != 0.0 && len > 1) {
+        const auto v = qr_.col(i).segment(i + 1, len - 1);
+        for (int j = i + 1; j < rows_; ++j) {
+          auto x = qr_.col(j).segment(i, len);
+          const double t = tau * (x(0) + v.dot(x.tail(len - 1)));
+          x(0) -= t;
+          x.tail(len - 1) -= t * v;
+        }
+      }
+      rank_ = i + 1;
+    }
   }
 
   // Scale-aware variant: threshold = tol · (largest row norm of M), so that tol is relative.
@@ -60,8 +97,22 @@ class NullSpace {
   // is Z_p = Z_{p−1} null(Â_p) of eq. (4).
   template <class Dest>
   void applyQOnTheRight(Dest& Y) const {
-    if (rows_ == 0 || cols_ == 0) return;
-    qr_.householderQ().applyThisOnTheRight(Y);
+    if (rank_ == 0) return;
+    Eigen::householderSequence(qr_, tau_).setLength(rank_).applyThisOnTheRight(Y);
+  }
+
+  // y ← Q y for a vector y of size cols() (e.g. u = Q u' back from the rotated coordinates).
+  template <class Vec>
+  void applyQOnTheLeft(Vec& y) const {
+    for (int i = rank_ - 1; i >= 0; --i) {
+      const double tau = tau_(i);
+      const int len = cols_ - i;
+      if (tau == 0.0 || len < 2) continue;
+      const auto v = qr_.col(i).segment(i + 1, len - 1);
+      const double t = tau * (y(i) + v.dot(y.segment(i + 1, len - 1)));
+      y(i) -= t;
+      y.segment(i + 1, len - 1) -= t * v;
+    }
   }
 
   // Orthonormal basis Z of null(M) (cols x dim).
@@ -88,18 +139,20 @@ class NullSpace {
   void rotatedMatrix(Dest& MQ) const {
     MQ.setZero(rows_, cols_);
     if (rank_ == 0) return;
-    const auto& R = qr_.matrixQR();
-    const auto& perm = qr_.colsPermutation().indices();
     for (int l = 0; l < rows_; ++l) {
       const int jmax = std::min(l + 1, rank_);
-      for (int j = 0; j < jmax; ++j) MQ(perm(l), j) = R(j, l);
+      for (int j = 0; j < jmax; ++j) MQ(perm_(l), j) = qr_(j, l);
     }
   }
 
-  const Decomposition& decomposition() const { return qr_; }
+  // Mᵀ Π = Q R in place: R on and above the diagonal (first rank() rows), reflectors below.
+  const Factor& matrixQR() const { return qr_; }
+  int permutation(int l) const { return perm_(l); }  // column l of Mᵀ Π is row Π(l) of M
 
  private:
-  Decomposition qr_;
+  Factor qr_;
+  Coeffs tau_;
+  Eigen::Matrix<int, Eigen::Dynamic, 1, 0, capacity(MaxRows), 1> perm_;
   int rows_ = 0;
   int cols_ = 0;
   int rank_ = 0;

@@ -33,6 +33,32 @@ struct QpMinNormWorkspace {
   Eigen::Matrix<double, MaxT, 1> work;      // Householder application scratch
 };
 
+// Reflector H = I − τ [1; v][1; v]ᵀ applied as one dot product and one axpy per column
+// (X ← H X, X column-major) or per row (X ← X H, X row-major). At the sizes of the QP
+// (≤ 31 long) Eigen's general applyHouseholderOn* is dominated by its call overhead.
+template <class Vec, class Mat>
+inline void reflectColumns(const Vec& v, double tau, Mat&& X) {
+  if (tau == 0.0) return;
+  const Eigen::Index len = X.rows();
+  for (Eigen::Index j = 0; j < X.cols(); ++j) {
+    auto x = X.col(j);
+    const double t = tau * (x(0) + v.dot(x.tail(len - 1)));
+    x(0) -= t;
+    x.tail(len - 1) -= t * v;
+  }
+}
+template <class Vec, class Mat>
+inline void reflectRows(const Vec& v, double tau, Mat&& X) {
+  if (tau == 0.0) return;
+  const Eigen::Index len = X.cols();
+  for (Eigen::Index i = 0; i < X.rows(); ++i) {
+    auto x = X.row(i);
+    const double t = tau * (x(0) + x.tail(len - 1).dot(v.transpose()));
+    x(0) -= t;
+    x.tail(len - 1) -= t * v.transpose();
+  }
+}
+
 // Householder QR in place of the leading rows × cols block of X (rows ≥ cols),
 // reflectors below the diagonal, R on and above it. Returns false as soon as a
 // diagonal entry |R(i,i)| ≤ abs_tol (rank-deficient: use the pivoted path).
@@ -45,11 +71,11 @@ inline bool qpHouseholderQr(Mat& X, int rows, int cols, double abs_tol, VecTau& 
     col.makeHouseholderInPlace(tau(i), beta);
     X(i, i) = beta;
     if (!(std::abs(beta) > abs_tol)) return false;
-    if (i + 1 < cols)
-      X.block(i, i + 1, rows - i, cols - i - 1)
-          .applyHouseholderOnTheLeft(X.col(i).segment(i + 1, rows - i - 1), tau(i),
-                                     work.data());
+    if (i + 1 < cols && rows - i > 1)
+      reflectColumns(X.col(i).segment(i + 1, rows - i - 1), tau(i),
+                     X.block(i, i + 1, rows - i, cols - i - 1));
   }
+  static_cast<void>(work);
   return true;
 }
 
@@ -107,10 +133,10 @@ inline int qpMinNormPivoted(MatM& M, int m, int c, VecR& r, VecP& p, double abs_
   p.head(c).setZero();
   if (rank == 0) return 0;
   if (rank == c) {  // full column rank: R11 w = y
-    for (int i = rank - 1; i >= 0; --i) {
-      double s = r(i);
-      for (int j = i + 1; j < rank; ++j) s -= M(i, j) * ws.w(j);
-      ws.w(i) = s / M(i, i);
+    ws.w.head(rank) = r.head(rank);
+    for (int i = rank - 1; i >= 0; --i) {  // by columns (M is column-major)
+      ws.w(i) /= M(i, i);
+      ws.w.head(i) -= ws.w(i) * M.col(i).head(i);
     }
   } else {
     // T = [R11 R12]ᵀ (c × rank) = U [L; 0]; Lᵀ z = y; w = U [z; 0].
@@ -120,9 +146,7 @@ inline int qpMinNormPivoted(MatM& M, int m, int c, VecR& r, VecP& p, double abs_
     }
     qpHouseholderQr(ws.T, c, rank, -1.0, ws.tau2, ws.work);
     for (int i = 0; i < rank; ++i) {
-      double s = r(i);
-      for (int j = 0; j < i; ++j) s -= ws.T(j, i) * ws.w(j);
-      ws.w(i) = s / ws.T(i, i);
+      ws.w(i) = (r(i) - ws.T.col(i).head(i).dot(ws.w.head(i))) / ws.T(i, i);
     }
     ws.w.segment(rank, c - rank).setZero();
     for (int i = rank - 1; i >= 0; --i) qpApplyReflector(ws.T, i, c, ws.tau2(i), ws.w);
@@ -145,10 +169,10 @@ inline int qpMinNormLeastSquares(MatM& M, int m, int c, VecR& r, VecP& p, double
     ws.S.topLeftCorner(m, c) = M.topLeftCorner(m, c);
     if (qpHouseholderQr(M, m, c, abs_tol, ws.tau1, ws.work)) {
       for (int i = 0; i < c; ++i) qpApplyReflector(M, i, m, ws.tau1(i), r);
-      for (int i = c - 1; i >= 0; --i) {  // R p = (Qᵀ r)(0:c)
-        double s = r(i);
-        for (int j = i + 1; j < c; ++j) s -= M(i, j) * p(j);
-        p(i) = s / M(i, i);
+      p.head(c) = r.head(c);
+      for (int i = c - 1; i >= 0; --i) {  // R p = (Qᵀ r)(0:c), by columns
+        p(i) /= M(i, i);
+        p.head(i) -= p(i) * M.col(i).head(i);
       }
       return c;
     }
@@ -157,9 +181,7 @@ inline int qpMinNormLeastSquares(MatM& M, int m, int c, VecR& r, VecP& p, double
     ws.T.topLeftCorner(c, m) = M.topLeftCorner(m, c).transpose();
     if (qpHouseholderQr(ws.T, c, m, abs_tol, ws.tau2, ws.work)) {
       for (int i = 0; i < m; ++i) {  // Rᵀ z = r, R = T(0:m, 0:m) upper triangular
-        double s = r(i);
-        for (int j = 0; j < i; ++j) s -= ws.T(j, i) * ws.w(j);
-        ws.w(i) = s / ws.T(i, i);
+        ws.w(i) = (r(i) - ws.T.col(i).head(i).dot(ws.w.head(i))) / ws.T(i, i);
       }
       ws.w.segment(m, c - m).setZero();
       for (int i = m - 1; i >= 0; --i) qpApplyReflector(ws.T, i, c, ws.tau2(i), ws.w);

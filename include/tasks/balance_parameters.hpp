@@ -1,0 +1,42 @@
+#pragma once
+// BalanceParameters: the numbers of the balance hierarchy (gains, friction, sole, torque
+// limits, level-4 weights). Plain data; robots/walker3/controller.yaml overrides them.
+// Defaults are chosen for Walker3 (43 kg, 1 kHz); the reasons are in docs/tasks.md.
+
+#include <Eigen/Core>
+
+#include "hqp/hqp_types.hpp"
+#include "tasks/pd_gains.hpp"
+
+namespace hqp::tasks {
+
+template <int NJ>
+struct BalanceParameters {
+  using VectorJ = Eigen::Matrix<double, NJ, 1>;
+  // Critically damped (kd = 2√kp): feet at 20 rad/s, CoM at 10 rad/s, torso at 14 rad/s,
+  // all far below the 1 kHz loop and ordered by priority (stiffer where it matters more).
+  PdGains foot_linear{400.0, 40.0};
+  PdGains foot_angular{400.0, 40.0};
+  PdGains com{100.0, 20.0};
+  PdGains torso{200.0, 28.28};
+  double mu = 0.6;        // friction coefficient (rubber sole on floor ~0.8–1; kept conservative)
+  double fz_min = 10.0;   // N, unilateral margin: ~2 % of the weight keeps a lightly loaded foot down
+  // CoP rectangle in the sole frame (m): the 0.22 × 0.10 sole box is centred on the sole frame
+  // (robots/walker3/README.md); 1 cm is kept from every edge for model error.
+  double sole_x_min = -0.10, sole_x_max = 0.10, sole_y_min = -0.04, sole_y_max = 0.04;
+  VectorJ tau_max = VectorJ::Constant(hqp::kInf);  // symmetric limits |τ| ≤ tau_max (N·m)
+  // Level-4 row weights: 1 rad/s² of torso error weighs as much as ~32 N of force error.
+  double torso_weight = 1.0;
+  double force_weight = 1e-3;
+};
+
+// Defaults with tau_max from the URDF effort limits of Robot.
+template <class Robot>
+BalanceParameters<Robot::nj> defaultBalanceParameters() {
+  BalanceParameters<Robot::nj> p;
+  constexpr int first = Robot::floating_base ? 1 : 0;
+  for (int j = 0; j < Robot::nj; ++j) p.tau_max(j) = Robot::bodies[static_cast<std::size_t>(j + first)].effort;
+  return p;
+}
+
+}  // namespace hqp::tasks

@@ -1,0 +1,258 @@
+#pragma once
+// loadControllerConfig<Robot>(path): reads a ControllerConfig from YAML with
+// yaml-cpp, at start-up only (allocates and throws; never call it in the tick).
+// Layout and the meaning of every key: robots/walker3/controller.yaml and
+// docs/controller.md ("Configuration"). The reader is strict: every key must
+// be present, no unknown key is accepted (a typo is an error, not a silent
+// default), per-joint entries are keyed by URDF joint name and must cover every
+// joint of Robot exactly once, and each value is range-checked. Any problem
+// throws std::runtime_error("<file>: <what> '<key path>'...").
+
+#include <cmath>
+#include <cstddef>
+#include <initializer_list>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "tasks/controller_config.hpp"
+
+namespace hqp::tasks {
+namespace detail {
+
+class ConfigReader {
+ public:
+  explicit ConfigReader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const std::string& what) const {
+    throw std::runtime_error(file_ + ": " + what);
+  }
+
+  static std::string join(const std::string& path, const std::string& key) {
+    return path.empty() ? key : path + "." + key;
+  }
+
+  // The map at path.key, with exactly the allowed keys (an empty list: any keys).
+  YAML::Node map(const YAML::Node& parent, const std::string& path, const std::string& key,
+                 std::initializer_list<const char*> allowed) const {
+    const std::string full = join(path, key);
+    const YAML::Node n = child(parent, path, key);
+    if (!n.IsMap()) fail("'" + full + "' must be a map");
+    onlyKeys(n, full, allowed);
+    return n;
+  }
+
+  void onlyKeys(const YAML::Node& m, const std::string& path,
+                std::initializer_list<const char*> allowed) const {
+    for (const auto& kv : m) {
+      const std::string k = kv.first.as<std::string>();
+      bool ok = false;
+      for (const char* a : allowed) ok = ok || k == a;
+      if (!ok) fail("unknown key '" + join(path, k) + "'");
+    }
+  }
+
+  YAML::Node child(const YAML::Node& parent, const std::string& path, const std::string& key) const {
+    const YAML::Node n = parent[key];
+    if (!n.IsDefined() || n.IsNull()) fail("missing key '" + join(path, key) + "'");
+    return n;
+  }
+
+  std::string text(const YAML::Node& parent, const std::string& path, const std::string& key) const {
+    const YAML::Node n = child(parent, path, key);
+    if (!n.IsScalar()) fail("'" + join(path, key) + "' must be a string");
+    return n.Scalar();
+  }
+
+  double number(const YAML::Node& n, const std::string& full) const {
+    if (!n.IsScalar()) fail("'" + full + "' must be a number");
+    double x = 0.0;
+    try {
+      x = n.as<double>();
+    } catch (const YAML::Exception&) {
+      fail("'" + full + "' must be a number, got '" + n.Scalar() + "'");
+    }
+    if (std::isnan(x)) fail("'" + full + "' is not a number (NaN)");
+    return x;
+  }
+
+  // A finite number at path.key with lo ≤ x (strictly lo < x if strict).
+  double atLeast(const YAML::Node& parent, const std::string& path, const std::string& key,
+                 double lo, bool strict, bool allow_inf = false) const {
+    const std::string full = join(path, key);
+    const double x = number(child(parent, path, key), full);
+    if (!allow_inf && !std::isfinite(x)) fail("'" + full + "' must be finite");
+    if (strict ? !(x > lo) : !(x >= lo)) {
+      fail("'" + full + "' = " + std::to_string(x) + " must be " + (strict ? "> " : ">= ") +
+           std::to_string(lo));
+    }
+    return x;
+  }
+
+  double finite(const YAML::Node& parent, const std::string& path, const std::string& key) const {
+    const std::string full = join(path, key);
+    const double x = number(child(parent, path, key), full);
+    if (!std::isfinite(x)) fail("'" + full + "' must be finite");
+    return x;
+  }
+
+  PdGains gains(const YAML::Node& parent, const std::string& path, const std::string& key) const {
+    const YAML::Node g = map(parent, path, key, {"kp", "kd"});
+    const std::string p = join(path, key);
+    return PdGains{atLeast(g, p, "kp", 0.0, false), atLeast(g, p, "kd", 0.0, false)};
+  }
+
+  // x_min < x_max, y_min < y_max (sole frame, m).
+  void rectangle(const YAML::Node& parent, const std::string& path, const std::string& key,
+                 double& x_min, double& x_max, double& y_min, double& y_max) const {
+    const YAML::Node r = map(parent, path, key, {"x_min", "x_max", "y_min", "y_max"});
+    const std::string p = join(path, key);
+    x_min = finite(r, p, "x_min");
+    x_max = finite(r, p, "x_max");
+    y_min = finite(r, p, "y_min");
+    y_max = finite(r, p, "y_max");
+    if (!(x_min < x_max) || !(y_min < y_max)) fail("'" + p + "' needs x_min < x_max and y_min < y_max");
+  }
+
+  // Entries of a per-joint map in model joint order; every joint exactly once.
+  template <class Robot>
+  std::vector<YAML::Node> perJoint(const YAML::Node& parent, const std::string& path,
+                                   const std::string& key) const {
+    const std::string full = join(path, key);
+    const YAML::Node m = child(parent, path, key);
+    if (!m.IsMap()) fail("'" + full + "' must be a map keyed by joint name");
+    std::vector<YAML::Node> out(static_cast<std::size_t>(Robot::nj));
+    std::vector<bool> seen(static_cast<std::size_t>(Robot::nj), false);
+    for (const auto& kv : m) {
+      const std::string name = kv.first.as<std::string>();
+      const int j = Robot::jointIndex(name);
+      if (j < 0) fail("unknown joint '" + name + "' in '" + full + "' (robot " + Robot::name + ")");
+      if (seen[static_cast<std::size_t>(j)]) fail("joint '" + name + "' twice in '" + full + "'");
+      seen[static_cast<std::size_t>(j)] = true;
+      out[static_cast<std::size_t>(j)] = kv.second;
+    }
+    for (int j = 0; j < Robot::nj; ++j) {
+      if (!seen[static_cast<std::size_t>(j)]) fail("missing key '" + join(full, jointName<Robot>(j)) + "'");
+    }
+    return out;
+  }
+
+  template <class Robot>
+  static const char* jointName(int j) {
+    return Robot::bodies[static_cast<std::size_t>(j + (Robot::floating_base ? 1 : 0))].joint;
+  }
+
+ private:
+  std::string file_;
+};
+
+}  // namespace detail
+
+template <class Robot>
+ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
+  constexpr int nj = Robot::nj;
+  const detail::ConfigReader r(path);
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    r.fail("cannot open the file");
+  } catch (const YAML::Exception& e) {
+    r.fail(std::string("YAML error: ") + e.what());
+  }
+  if (!root.IsMap()) r.fail("the top level must be a map");
+  r.onlyKeys(root, "", {"controller", "balance", "planner", "estimator", "joint_control", "safe_mode"});
+
+  ControllerConfig<nj> c;
+  {
+    const YAML::Node n = r.map(root, "", "controller", {"solver", "dt", "wqp_priority_ratio"});
+    const std::string solver = r.text(n, "controller", "solver");
+    if (solver == "hqp") {
+      c.solver = ControllerConfig<nj>::Solver::Hqp;
+    } else if (solver == "wqp") {
+      c.solver = ControllerConfig<nj>::Solver::Wqp;
+    } else {
+      r.fail("'controller.solver' must be hqp or wqp, got '" + solver + "'");
+    }
+    c.dt = r.atLeast(n, "controller", "dt", 0.0, true);
+    c.wqp_priority_ratio = r.atLeast(n, "controller", "wqp_priority_ratio", 1.0, false);
+  }
+  {
+    const std::string p = "balance";
+    const YAML::Node n = r.map(root, "", p,
+                               {"foot_linear", "foot_angular", "com", "torso", "mu", "fz_min",
+                                "cop_region", "torque_limit", "torso_weight", "force_weight"});
+    BalanceParameters<nj>& b = c.balance;
+    b.foot_linear = r.gains(n, p, "foot_linear");
+    b.foot_angular = r.gains(n, p, "foot_angular");
+    b.com = r.gains(n, p, "com");
+    b.torso = r.gains(n, p, "torso");
+    b.mu = r.atLeast(n, p, "mu", 0.0, true);
+    b.fz_min = r.atLeast(n, p, "fz_min", 0.0, false);
+    r.rectangle(n, p, "cop_region", b.sole_x_min, b.sole_x_max, b.sole_y_min, b.sole_y_max);
+    b.torso_weight = r.atLeast(n, p, "torso_weight", 0.0, false);
+    b.force_weight = r.atLeast(n, p, "force_weight", 0.0, false);
+    const std::vector<YAML::Node> lim = r.perJoint<Robot>(n, p, "torque_limit");
+    for (int j = 0; j < nj; ++j) {
+      const std::string key = r.join(p + ".torque_limit", detail::ConfigReader::jointName<Robot>(j));
+      const double t = r.number(lim[static_cast<std::size_t>(j)], key);
+      if (!(t > 0.0) || !std::isfinite(t)) r.fail("'" + key + "' must be finite and > 0");
+      const double effort = Robot::bodies[static_cast<std::size_t>(j + (Robot::floating_base ? 1 : 0))].effort;
+      if (t > effort) {
+        r.fail("'" + key + "' = " + std::to_string(t) + " exceeds the URDF effort limit " +
+               std::to_string(effort));
+      }
+      b.tau_max[j] = t;
+    }
+  }
+  {
+    const std::string p = "planner";
+    const YAML::Node n = r.map(root, "", p, {"safe_margin", "com_height", "sole", "torso_yaw_offset"});
+    PlannerParameters& pl = c.planner;
+    pl.safe_margin = r.atLeast(n, p, "safe_margin", 0.0, false);
+    pl.com_height = r.finite(n, p, "com_height");
+    r.rectangle(n, p, "sole", pl.sole_x_min, pl.sole_x_max, pl.sole_y_min, pl.sole_y_max);
+    if (!(2.0 * pl.safe_margin < pl.sole_x_max - pl.sole_x_min) ||
+        !(2.0 * pl.safe_margin < pl.sole_y_max - pl.sole_y_min)) {
+      r.fail("'planner.safe_margin' leaves no safe region inside 'planner.sole'");
+    }
+    pl.torso_yaw_offset = r.finite(n, p, "torso_yaw_offset");
+  }
+  {
+    const YAML::Node n = r.map(root, "", "estimator", {"contact_threshold"});
+    c.estimator.contact_threshold = r.atLeast(n, "estimator", "contact_threshold", 0.0, true);
+  }
+  {
+    const std::string p = "joint_control";
+    const YAML::Node n = r.map(root, "", p, {"leak_time", "joints"});
+    c.joint.leak_time = r.atLeast(n, p, "leak_time", 0.0, false, /*allow_inf=*/true);
+    const std::vector<YAML::Node> js = r.perJoint<Robot>(n, p, "joints");
+    for (int j = 0; j < nj; ++j) {
+      const std::string jp = r.join(p + ".joints", detail::ConfigReader::jointName<Robot>(j));
+      const YAML::Node& e = js[static_cast<std::size_t>(j)];
+      if (!e.IsMap()) r.fail("'" + jp + "' must be a map");
+      r.onlyKeys(e, jp, {"torque_constant", "current_limit", "coulomb", "viscous", "dq_star", "k_f", "k_dq"});
+      c.joint.torque_constant[j] = r.atLeast(e, jp, "torque_constant", 0.0, true);
+      c.joint.current_limit[j] = r.atLeast(e, jp, "current_limit", 0.0, true);
+      JointFriction& f = c.joint.friction[static_cast<std::size_t>(j)];
+      f.coulomb = r.atLeast(e, jp, "coulomb", 0.0, false);
+      f.viscous = r.atLeast(e, jp, "viscous", 0.0, false);
+      f.dq_star = r.atLeast(e, jp, "dq_star", 0.0, true);
+      c.joint.k_f[j] = r.atLeast(e, jp, "k_f", 0.0, false);
+      c.joint.k_dq[j] = r.atLeast(e, jp, "k_dq", 0.0, false);
+    }
+  }
+  {
+    const std::string p = "safe_mode";
+    const YAML::Node n = r.map(root, "", p, {"damping", "min_base_height", "max_tilt"});
+    c.safe.damping = r.atLeast(n, p, "damping", 0.0, false);
+    c.safe.min_base_height = r.finite(n, p, "min_base_height");
+    c.safe.max_tilt = r.atLeast(n, p, "max_tilt", 0.0, true);
+  }
+  return c;
+}
+
+}  // namespace hqp::tasks

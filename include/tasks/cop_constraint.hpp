@@ -1,0 +1,64 @@
+#pragma once
+// Level 2 constraint: the centre of pressure of each flat foot inside its sole rectangle
+// (Section III-B). With the world-aligned wrench [f; m] about the sole origin rotated into the
+// sole frame (f_s = Rᵀ f, m_s = Rᵀ m), the CoP is p = (−m_sy / f_sz, m_sx / f_sz), and
+//   x_min f_sz ≤ −m_sy ≤ x_max f_sz,   y_min f_sz ≤ m_sx ≤ y_max f_sz
+// is linear in F: 4 one-sided rows per foot, D x ≤ 0, in the order
+//   −m_y − x_max f_z ≤ 0,   m_y + x_min f_z ≤ 0,   m_x − y_max f_z ≤ 0,   −m_x + y_min f_z ≤ 0.
+// Only for flat feet (CD = 6).
+
+#include <Eigen/Core>
+
+#include "hqp/constraint.hpp"
+#include "tasks/contact_frame.hpp"
+#include "tasks/contact_layout.hpp"
+#include "tasks/references.hpp"
+
+namespace hqp::tasks {
+
+template <class Layout>
+class CopConstraint : public hqp::Constraint<4 * Layout::num_contacts, Layout::nx> {
+  static_assert(Layout::contact_dim == 6, "the CoP needs a 6-D contact wrench");
+
+ public:
+  using layout = Layout;
+  static constexpr int NC = Layout::num_contacts;
+
+  // CoP rectangle in the sole frame (m).
+  double x_min = -0.10, x_max = 0.10, y_min = -0.04, y_max = 0.04;
+
+  CopConstraint() {
+    this->name = "center_of_pressure";
+    this->lower.setConstant(-hqp::kInf);
+    this->upper.setZero();
+  }
+
+  template <class Dyn>
+  void update(const Dyn& dyn, const References<NC>&) noexcept {
+    for (int c = 0; c < NC; ++c) {
+      const Eigen::Matrix3d R = contactSurfaceRotation<6>(dyn, c);
+      // Sole axes in world coordinates: f_sz = n·f, m_sx = t_x·m, m_sy = t_y·m.
+      const Eigen::RowVector3d tx = R.col(0).transpose(), ty = R.col(1).transpose(),
+                               n = R.col(2).transpose();
+      auto Dc = this->D.template block<4, 6>(4 * c, Layout::forceIndex(c));
+      Dc.template block<1, 3>(0, 0) = -x_max * n;
+      Dc.template block<1, 3>(0, 3) = -ty;
+      Dc.template block<1, 3>(1, 0) = x_min * n;
+      Dc.template block<1, 3>(1, 3) = ty;
+      Dc.template block<1, 3>(2, 0) = -y_max * n;
+      Dc.template block<1, 3>(2, 3) = tx;
+      Dc.template block<1, 3>(3, 0) = y_min * n;
+      Dc.template block<1, 3>(3, 3) = -tx;
+    }
+  }
+
+  template <class P>
+  void configure(const P& p) noexcept {
+    x_min = p.sole_x_min;
+    x_max = p.sole_x_max;
+    y_min = p.sole_y_min;
+    y_max = p.sole_y_max;
+  }
+};
+
+}  // namespace hqp::tasks

@@ -1,0 +1,75 @@
+// The balance controller (include/tasks/controller.hpp) as the simulation's driver. The only
+// translation unit of sim_demo that instantiates the hierarchy (it is expensive to compile).
+#include <cstdio>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "run.hpp"
+#include "tasks/contact_layout.hpp"
+#include "tasks/controller.hpp"
+#include "tasks/controller_config_yaml.hpp"
+
+namespace hqp::sim {
+
+namespace {
+
+using Layout = hqp::tasks::ContactLayout<Robot, kContacts, 6>;
+using BalanceController = hqp::tasks::Controller<Layout>;
+
+class BalanceDriver final : public Driver {
+ public:
+  explicit BalanceDriver(const hqp::tasks::ControllerConfig<kJoints>& config)
+      : controller_(std::make_unique<BalanceController>(
+            config, std::array<int, kContacts>{Robot::Frames::l_sole, Robot::Frames::r_sole},
+            std::array<int, kContacts>{Robot::Frames::l_ft_sensor, Robot::Frames::r_ft_sensor}, Robot::Frames::imu)),
+        name_(config.solver == hqp::tasks::ControllerConfig<kJoints>::Solver::Hqp ? "balance controller (HQP)"
+                                                                                    : "balance controller (WQP)") {}
+  const char* name() const override { return name_; }
+  void reset() override { controller_->reset(); }
+  void tick(const Sensors& s, Command& cmd) override { controller_->tick(s, cmd); }
+  bool safeMode() const override {
+    return controller_->diagnostics().mode == hqp::tasks::ControllerMode::Safe;
+  }
+  std::string logHeader() const override {
+    std::string h = ",ctrl_status";
+    for (int l = 1; l <= BalanceController::num_levels; ++l) {
+      h += ",level" + std::to_string(l) + "_status,level" + std::to_string(l) + "_residual,level" +
+           std::to_string(l) + "_active";
+    }
+    for (const char* f : {"l", "r"}) {
+      const std::string p = std::string(",") + f;
+      h += p + "_in_contact" + p + "_following" + p + "_zmp_meas_x" + p + "_zmp_meas_y" + p + "_zmp_opt_x" + p +
+           "_zmp_opt_y";
+    }
+    return h + ",com_err_x,com_err_y,com_err_z,torso_err_x,torso_err_y,torso_err_z,current_saturated";
+  }
+  void logRow(std::FILE* f) const override {
+    const auto& d = controller_->diagnostics();
+    std::fprintf(f, ",%d", static_cast<int>(d.status));
+    for (const auto& l : d.levels) std::fprintf(f, ",%d,%.6g,%d", static_cast<int>(l.status), l.residual, l.num_active);
+    for (int c = 0; c < kContacts; ++c) {
+      std::fprintf(f, ",%d,%d,%.5f,%.5f,%.5f,%.5f", d.in_contact[c] ? 1 : 0, d.following[c] ? 1 : 0,
+                   d.zmp_measured[c].x(), d.zmp_measured[c].y(), d.zmp_optimized[c].x(), d.zmp_optimized[c].y());
+    }
+    std::fprintf(f, ",%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d", d.com_error.x(), d.com_error.y(), d.com_error.z(),
+                 d.torso_error.x(), d.torso_error.y(), d.torso_error.z(), d.current_saturated ? 1 : 0);
+  }
+
+ private:
+  std::unique_ptr<BalanceController> controller_;  // large: keep it off the stack
+  const char* name_;
+};
+
+}  // namespace
+
+std::unique_ptr<Driver> makeBalanceController(const std::string& config_path, bool wqp) {
+  auto config = hqp::tasks::loadControllerConfig<Robot>(config_path);
+  using Solver = hqp::tasks::ControllerConfig<kJoints>::Solver;
+  config.solver = wqp ? Solver::Wqp : Solver::Hqp;
+  return std::make_unique<BalanceDriver>(config);
+}
+
+bool balanceControllerAvailable() { return true; }
+
+}  // namespace hqp::sim

@@ -1,0 +1,9 @@
+// Builds without the balance controller (HQP_SIM_WITH_CONTROLLER off): the PD stand-in only.
+#include "run.hpp"
+
+namespace hqp::sim {
+
+std::unique_ptr<Driver> makeBalanceController(const std::string&, bool) { return nullptr; }
+bool balanceControllerAvailable() { return false; }
+
+}  // namespace hqp::sim

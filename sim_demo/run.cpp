@@ -1,0 +1,203 @@
+#include "run.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+#include "video_recorder.hpp"
+
+namespace hqp::sim {
+
+namespace {
+
+class JointPdDriver final : public Driver {
+ public:
+  JointPdDriver(const VectorJ& q_ref, const VectorJ& k_t, double kp, double kd)
+      : q_ref_(q_ref), k_t_(k_t), kp_(kp), kd_(kd) {}
+  const char* name() const override { return "joint PD"; }
+  void reset() override {}
+  void tick(const Sensors& s, Command& cmd) override {
+    cmd.torque = kp_ * (q_ref_ - s.q) - kd_ * s.dq;
+    cmd.current = cmd.torque.cwiseQuotient(k_t_);
+    cmd.safe_mode = false;
+  }
+
+ private:
+  VectorJ q_ref_, k_t_;
+  double kp_, kd_;
+};
+
+// A CSV file with one row per tick (docs/simulation.md lists the columns).
+class CsvLog {
+ public:
+  CsvLog(const std::string& path, const Driver& driver) : f_(std::fopen(path.c_str(), "w")), driver_(driver) {
+    if (!f_) throw std::runtime_error("cannot write " + path);
+    std::setvbuf(f_, nullptr, _IOFBF, 1 << 20);
+    std::fprintf(f_, "time");
+    for (int i = 0; i < kJoints; ++i) std::fprintf(f_, ",q_%s", Robot::bodies[i + 1].joint);
+    for (int i = 0; i < kJoints; ++i) std::fprintf(f_, ",tau_%s", Robot::bodies[i + 1].joint);
+    for (const char* foot : {"l", "r"}) {
+      for (const char* c : {"fx", "fy", "fz", "mx", "my", "mz"}) std::fprintf(f_, ",%s_ft_%s", foot, c);
+    }
+    std::fprintf(f_, ",l_cop_x,l_cop_y,r_cop_x,r_cop_y,torso_pitch,torso_roll,torso_z,com_x,com_y,com_z,"
+                     "push_fx,push_fy,push_fz,ball_px,ball_py,ball_pz,tick_us,safe_mode%s\n", driver_.logHeader().c_str());
+  }
+  ~CsvLog() { std::fclose(f_); }
+  void row(const Simulation& sim, const Sensors& s, const Eigen::Vector3d& push, double tick_us, bool safe) {
+    std::fprintf(f_, "%.4f", s.time);
+    const VectorJ q = sim.jointPositions(), tau = sim.appliedTorque();
+    for (int i = 0; i < kJoints; ++i) std::fprintf(f_, ",%.6f", q[i]);
+    for (int i = 0; i < kJoints; ++i) std::fprintf(f_, ",%.4f", tau[i]);
+    for (int c = 0; c < kContacts; ++c) {
+      for (int k = 0; k < 6; ++k) std::fprintf(f_, ",%.4f", s.ft[c][k]);
+    }
+    for (int c = 0; c < kContacts; ++c) {
+      const Eigen::Vector2d cop = sim.copInSole(c, s.ft[c]);
+      std::fprintf(f_, ",%.5f,%.5f", cop.x(), cop.y());
+    }
+    const Eigen::Vector3d com = sim.centerOfMass();
+    const Eigen::Vector3d ball = sim.ballMomentum();
+    std::fprintf(f_, ",%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.2f,%.2f,%.2f,%.4f,%.4f,%.4f,%.2f,%d", sim.torsoPitch(),
+                 sim.torsoRoll(), sim.torsoHeight(), com.x(), com.y(), com.z(), push.x(), push.y(), push.z(), ball.x(),
+                 ball.y(), ball.z(), tick_us, safe ? 1 : 0);
+    driver_.logRow(f_);
+    std::fputc('\n', f_);
+  }
+
+ private:
+  std::FILE* f_;
+  const Driver& driver_;
+};
+
+}  // namespace
+
+std::unique_ptr<Driver> makeJointPdDriver(const Simulation& sim, double kp, double kd) {
+  return std::make_unique<JointPdDriver>(sim.standingPose(), sim.torqueConstant(), kp, kd);
+}
+
+RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
+  RunSummary r;
+  r.driver = driver.name();
+  std::unique_ptr<CsvLog> log;
+  std::unique_ptr<VideoRecorder> video;
+  if (!o.out_dir.empty()) {
+    std::filesystem::create_directories(o.out_dir);
+    r.csv_path = o.out_dir + "/" + o.scenario + ".csv";
+    log = std::make_unique<CsvLog>(r.csv_path, driver);
+    if (o.video) {
+      r.video_path = o.out_dir + "/" + o.scenario + ".mp4";
+      video = std::make_unique<VideoRecorder>(sim.model(), r.video_path, o.video_width, o.video_height, o.video_fps,
+                                              mj_name2id(sim.model(), mjOBJ_BODY, Robot::bodies[0].name));
+    }
+  }
+  sim.reset();
+  driver.reset();
+  const long ticks = std::lround(o.duration / sim.controlDt());
+  std::vector<double> tick_us;
+  tick_us.reserve(static_cast<std::size_t>(ticks));
+  Sensors s;
+  Command cmd;
+  double next_frame = 0.0;
+  long next_progress = std::lround(1.0 / sim.controlDt());
+  const auto wall0 = std::chrono::steady_clock::now();
+  double video_s = 0.0;
+  for (int c = 0; c < kContacts; ++c) {
+    r.cop_min[c].setConstant(std::numeric_limits<double>::infinity());
+    r.cop_max[c].setConstant(-std::numeric_limits<double>::infinity());
+  }
+  const double com_x0 = sim.centerOfMass().x();
+  // Delivered ball impulse: momentum at launch (straight flight) minus momentum when the ball
+  // leaves the robot. 0: idle, 1: flying, 2: touching the robot.
+  int ball_state = 0;
+  Eigen::Vector3d ball_p0 = Eigen::Vector3d::Zero();
+  for (long k = 0; k < ticks; ++k) {
+    sim.readSensors(s);
+    const auto t0 = std::chrono::steady_clock::now();
+    driver.tick(s, cmd);
+    const double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
+    tick_us.push_back(us);
+    if (driver.safeMode()) ++r.safe_mode_ticks;
+    sim.applyCommand(cmd);
+    Eigen::Vector3d push = Eigen::Vector3d::Zero();
+    for (const Push& p : o.pushes) {
+      if (p.ball) {
+        if (std::abs(sim.time() - p.time) < 0.5 * sim.controlDt()) {
+          if (!sim.hasBall()) throw std::runtime_error("the scene has no ball to throw");
+          sim.launchBall(p.impulse);
+          ball_p0 = sim.ballMomentum();
+          ball_state = 1;
+        }
+      } else if (sim.time() + 1e-9 >= p.time && sim.time() + 1e-9 < p.time + p.duration) {
+        push += p.impulse / p.duration;
+      }
+    }
+    sim.setTorsoForce(push);
+    if (log) log->row(sim, s, push, us, driver.safeMode());
+    if (video && sim.time() + 1e-9 >= next_frame) {
+      const auto v0 = std::chrono::steady_clock::now();
+      video->frame(sim.data());
+      video_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - v0).count();
+      next_frame += 1.0 / o.video_fps;
+    }
+    for (int c = 0; c < kContacts; ++c) {
+      const Eigen::Vector2d cop = sim.copInSole(c, s.ft[c]);
+      if (!cop.allFinite()) continue;
+      r.cop_min[c] = r.cop_min[c].cwiseMin(cop);
+      r.cop_max[c] = r.cop_max[c].cwiseMax(cop);
+    }
+    sim.step();
+    if (ball_state > 0) {
+      const bool touching = sim.ballTouchesRobot();
+      if (ball_state == 1 && touching) ball_state = 2;
+      if (ball_state == 2 && !touching) {
+        r.ball_impulse += ball_p0 - sim.ballMomentum();
+        ball_state = 0;
+      }
+    }
+
+    if (sim.feetTouch()) ++r.feet_touch_ticks;
+    const double com_dx = sim.centerOfMass().x() - com_x0;
+    r.com_x_min = std::min(r.com_x_min, com_dx);
+    r.com_x_max = std::max(r.com_x_max, com_dx);
+    const double pitch = sim.torsoPitch(), roll = sim.torsoRoll(), z = sim.torsoHeight();
+    r.max_abs_pitch = std::max(r.max_abs_pitch, std::abs(pitch));
+    r.max_abs_roll = std::max(r.max_abs_roll, std::abs(roll));
+    r.min_torso_height = std::min(r.min_torso_height, z);
+    r.duration = sim.time();
+    if (!r.fell) {
+      if (z < o.fall_height) r.fall_reason = "torso below " + std::to_string(o.fall_height) + " m";
+      else if (std::abs(pitch) > o.fall_tilt || std::abs(roll) > o.fall_tilt) r.fall_reason = "torso tilt";
+      else if (sim.nonFootContact()) r.fall_reason = "contact other than the soles";
+      if (!r.fall_reason.empty()) {
+        r.fell = true;
+        r.fall_time = sim.time();
+        break;
+      }
+    }
+    if (o.progress && k + 1 == next_progress) {
+      std::printf("  t = %5.1f / %.1f s  pitch %6.2f deg  roll %6.2f deg  torso z %.3f m\n", sim.time(), o.duration,
+                  pitch * 180 / M_PI, roll * 180 / M_PI, z);
+      std::fflush(stdout);
+      next_progress += std::lround(1.0 / sim.controlDt());
+    }
+  }
+  r.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  // The real-time factor of the loop itself, without video rendering (which is offline work).
+  r.real_time_factor = r.duration / std::max(1e-9, r.wall_time - video_s);
+  if (!tick_us.empty()) {
+    double sum = 0;
+    for (double t : tick_us) sum += t;
+    r.tick_mean_us = sum / tick_us.size();
+    std::sort(tick_us.begin(), tick_us.end());
+    r.tick_max_us = tick_us.back();
+    r.tick_p999_us = tick_us[std::min(tick_us.size() - 1, static_cast<std::size_t>(0.999 * tick_us.size()))];
+  }
+  return r;
+}
+
+}  // namespace hqp::sim

@@ -1,0 +1,86 @@
+#pragma once
+// One simulated run: the 1 kHz loop sensors -> driver (controller) -> currents -> plant, with a
+// CSV log, fall detection, timing and an optional video. Not real-time code.
+
+#include <array>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "simulation.hpp"
+
+namespace hqp::sim {
+
+// What sits between the sensors and the motors. Virtual is fine here: this is the simulator,
+// not the controller's real-time path.
+class Driver {
+ public:
+  virtual ~Driver() = default;
+  virtual const char* name() const = 0;
+  virtual void reset() = 0;
+  virtual void tick(const Sensors& s, Command& cmd) = 0;
+  virtual bool safeMode() const { return false; }
+  // Extra CSV columns of this driver (diagnostics): header text starting with ',' and one row.
+  virtual std::string logHeader() const { return {}; }
+  virtual void logRow(std::FILE*) const {}
+};
+
+// Joint PD to the standing pose from encoder data only (the stand-in before the balance
+// controller): τ = kp (q* − q) − kd q̇, current = τ / k_t.
+std::unique_ptr<Driver> makeJointPdDriver(const Simulation& sim, double kp = 400.0, double kd = 10.0);
+
+// The balance controller (include/tasks/controller.hpp) configured from a controller YAML file;
+// nullptr when this build has no controller (HQP_SIM_WITH_CONTROLLER off).
+std::unique_ptr<Driver> makeBalanceController(const std::string& config_path, bool wqp);
+bool balanceControllerAvailable();
+
+// An impulse on the torso: a constant force impulse / duration at the torso's centre of mass
+// from `time` on (xfrc_applied).
+// With `ball`, the scene's ball is thrown instead, with momentum `impulse` (what it would
+// deliver if it stopped dead; Simulation::launchBall).
+struct Push {
+  double time = 1.0;                                    // s
+  Eigen::Vector3d impulse = Eigen::Vector3d::Zero();    // N·s, world
+  double duration = 0.01;                               // s
+  bool ball = false;
+};
+
+struct RunOptions {
+  std::string scenario = "stand";
+  double duration = 10.0;          // s
+  std::string out_dir;             // CSV (and video) go here; empty: no files
+  bool video = false;
+  int video_width = 640, video_height = 480, video_fps = 30;
+  double fall_height = 0.6;        // m, torso frame below this = fall
+  double fall_tilt = 1.0;          // rad, torso pitch or roll beyond this = fall
+  bool progress = false;           // a progress line every simulated second
+  std::vector<Push> pushes;
+};
+
+struct RunSummary {
+  std::string driver;
+  double duration = 0;             // simulated s
+  bool fell = false;
+  double fall_time = -1;           // s, -1 when no fall
+  std::string fall_reason;
+  double max_abs_pitch = 0, max_abs_roll = 0;  // rad, torso
+  double min_torso_height = 1e9;   // m
+  double wall_time = 0;            // s
+  double real_time_factor = 0;     // simulated / wall
+  double tick_mean_us = 0, tick_max_us = 0, tick_p999_us = 0;  // driver compute time
+  long safe_mode_ticks = 0;
+  long feet_touch_ticks = 0;       // ticks with the two sole plates in contact with each other
+  Eigen::Vector3d ball_impulse = Eigen::Vector3d::Zero();  // N·s the thrown balls lost (delivered)
+  // Measured CoP (sole frame, from the F/T data) extremes per foot while loaded (f_z >= 10 N).
+  std::array<Eigen::Vector2d, kContacts> cop_min, cop_max;
+  double com_x_min = 0, com_x_max = 0;  // m, CoM x excursion relative to t = 0
+  std::string csv_path, video_path;
+};
+
+// Runs until `duration` or the first fall (the run stops there).
+RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& options);
+
+}  // namespace hqp::sim

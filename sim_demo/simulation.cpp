@@ -1,0 +1,280 @@
+#include "simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace hqp::sim {
+
+namespace {
+
+int requireId(const mjModel* m, mjtObj type, const std::string& name, const char* what) {
+  const int id = mj_name2id(m, type, name.c_str());
+  if (id < 0) throw std::runtime_error(std::string("scene has no ") + what + " '" + name + "'");
+  return id;
+}
+
+}  // namespace
+
+Simulation::Simulation(const SimulationOptions& options) : options_(options), rng_(options.seed) {
+  if (!(options_.control_dt > 0) || options_.substeps < 1) throw std::runtime_error("invalid control_dt / substeps");
+  plant_ = loadPlantConfig(options_.plant);
+  if (static_cast<int>(plant_.force_torque.size()) != kContacts) {
+    throw std::runtime_error(options_.plant + ": expected 2 force_torque sensors (left, right)");
+  }
+  char error[1024] = {0};
+  m_ = mj_loadXML(options_.scene.c_str(), nullptr, error, sizeof(error));
+  if (!m_) throw std::runtime_error("cannot load scene " + options_.scene + ": " + error);
+  m_->opt.timestep = options_.control_dt / options_.substeps;
+  d_ = mj_makeData(m_);
+
+  for (int i = 0; i < kJoints; ++i) {
+    const std::string jn = Robot::bodies[i + 1].joint;  // joint i moves body i + 1 (floating base)
+    const int j = requireId(m_, mjOBJ_JOINT, jn, "joint");
+    qadr_[i] = m_->jnt_qposadr[j];
+    dofadr_[i] = m_->jnt_dofadr[j];
+    act_[i] = requireId(m_, mjOBJ_ACTUATOR, jn, "actuator");
+    jpos_[i] = sensorAdr(jn + "_pos", 1);
+    jvel_[i] = sensorAdr(jn + "_vel", 1);
+    k_t_[i] = plant_.joint(jn).torque_constant;
+    const std::string s = jn.substr(2);
+    q_stand_[i] = s == "hip_pitch" ? options_.hip_pitch
+                : s == "knee" ? options_.knee
+                : s == "ankle_pitch" ? options_.ankle_pitch
+                : 0.0;
+  }
+  imu_quat_ = sensorAdr("imu_quat", 4);
+  imu_gyro_ = sensorAdr("imu_gyro", 3);
+  imu_accel_ = sensorAdr("imu_accel", 3);
+  torso_ = requireId(m_, mjOBJ_BODY, Robot::bodies[0].name, "body");
+  if (m_->body_jntnum[torso_] != 1 || m_->jnt_type[m_->body_jntadr[torso_]] != mjJNT_FREE) {
+    throw std::runtime_error("the robot's root body has no free joint");
+  }
+  base_qadr_ = m_->jnt_qposadr[m_->body_jntadr[torso_]];
+  base_dofadr_ = m_->jnt_dofadr[m_->body_jntadr[torso_]];
+  ball_ = mj_name2id(m_, mjOBJ_BODY, "ball");
+  if (ball_ >= 0) {
+    if (m_->body_jntnum[ball_] != 1 || m_->jnt_type[m_->body_jntadr[ball_]] != mjJNT_FREE || !(m_->body_mass[ball_] > 0)) {
+      throw std::runtime_error("scene body 'ball' needs a free joint and a mass");
+    }
+    ball_qadr_ = m_->jnt_qposadr[m_->body_jntadr[ball_]];
+    ball_dofadr_ = m_->jnt_dofadr[m_->body_jntadr[ball_]];
+  }
+  for (int c = 0; c < kContacts; ++c) {
+    const ForceTorqueSite& ft = plant_.force_torque[c];
+    ft_force_[c] = sensorAdr(ft.name + "_force", 3);
+    ft_torque_[c] = sensorAdr(ft.name + "_torque", 3);
+    sole_body_[c] = requireId(m_, mjOBJ_BODY, ft.sole, "body");
+    const int site = requireId(m_, mjOBJ_SITE, ft.name, "site");
+    if (m_->site_bodyid[site] != sole_body_[c]) throw std::runtime_error("F/T site " + ft.name + " is not on its sole body");
+    // The site is placed relative to the sole body, whose frame is the sole frame.
+    const double* sq = m_->site_quat + 4 * site;
+    R_sole_ft_[c] = Eigen::Quaterniond(sq[0], sq[1], sq[2], sq[3]).normalized().toRotationMatrix();
+    p_sole_ft_[c] = Eigen::Vector3d(m_->site_pos[3 * site], m_->site_pos[3 * site + 1], m_->site_pos[3 * site + 2]);
+  }
+  reset();
+}
+
+Simulation::~Simulation() {
+  mj_deleteData(d_);
+  mj_deleteModel(m_);
+}
+
+int Simulation::sensorAdr(const std::string& name, int dim) const {
+  const int id = requireId(m_, mjOBJ_SENSOR, name, "sensor");
+  if (m_->sensor_dim[id] != dim) throw std::runtime_error("sensor " + name + " has the wrong dimension");
+  return m_->sensor_adr[id];
+}
+
+void Simulation::reset() {
+  mj_resetData(m_, d_);
+  // Free joint: position, quaternion (w x y z, upright).
+  double* base = d_->qpos + base_qadr_;
+  base[0] = base[1] = 0.0;
+  base[2] = 1.0;
+  base[3] = 1.0;
+  base[4] = base[5] = base[6] = 0.0;
+  for (int i = 0; i < kJoints; ++i) d_->qpos[qadr_[i]] = q_stand_[i];
+  mj_kinematics(m_, d_);
+  // Lower the base until the lower sole touches z = 0.
+  double lowest = std::numeric_limits<double>::infinity();
+  for (int c = 0; c < kContacts; ++c) lowest = std::min(lowest, d_->xpos[3 * sole_body_[c] + 2]);
+  base[2] -= lowest;
+  for (int u = 0; u < m_->nu; ++u) d_->ctrl[u] = 0.0;
+  ball_flying_ = false;  // mj_resetData parked the ball at its qpos0
+  mj_forward(m_, d_);
+}
+
+void Simulation::launchBall(const Eigen::Vector3d& momentum, double distance) {
+  if (ball_ < 0 || !(momentum.norm() > 0)) return;
+  const Eigen::Vector3d v = momentum / m_->body_mass[ball_];
+  const Eigen::Vector3d target(d_->xipos + 3 * torso_);
+  const Eigen::Vector3d start = target - distance * v.normalized();
+  double* q = d_->qpos + ball_qadr_;
+  q[0] = start.x();
+  q[1] = start.y();
+  q[2] = start.z();
+  q[3] = 1.0;
+  q[4] = q[5] = q[6] = 0.0;
+  double* w = d_->qvel + ball_dofadr_;
+  for (int k = 0; k < 3; ++k) {
+    w[k] = v[k];
+    w[3 + k] = 0.0;
+  }
+  ball_flying_ = true;
+  for (int k = 0; k < 6; ++k) d_->xfrc_applied[6 * ball_ + k] = 0.0;
+  d_->xfrc_applied[6 * ball_ + 2] = -m_->body_mass[ball_] * m_->opt.gravity[2];  // straight flight
+  mj_forward(m_, d_);
+}
+
+Eigen::Vector3d Simulation::ballMomentum() const {
+  if (ball_ < 0) return Eigen::Vector3d::Zero();
+  return m_->body_mass[ball_] * Eigen::Vector3d(d_->qvel + ball_dofadr_);  // free joint: world linear velocity
+}
+
+void Simulation::readSensors(Sensors& s) {
+  const double* sd = d_->sensordata;
+  s.time = d_->time;
+  for (int i = 0; i < kJoints; ++i) {
+    s.q[i] = sd[jpos_[i]];
+    s.dq[i] = sd[jvel_[i]];
+  }
+  s.imu_orientation = Eigen::Quaterniond(sd[imu_quat_], sd[imu_quat_ + 1], sd[imu_quat_ + 2], sd[imu_quat_ + 3]);
+  s.imu_orientation.normalize();
+  s.imu_gyro = Eigen::Vector3d(sd + imu_gyro_);
+  s.imu_accel = Eigen::Vector3d(sd + imu_accel_);
+  for (int c = 0; c < kContacts; ++c) {
+    // MuJoCo reads the wrench of the parent (foot) on the massless sole-plate body, which the
+    // contact balances exactly: the support's wrench on the foot is its negative.
+    s.ft[c].head<3>() = -Eigen::Vector3d(sd + ft_force_[c]);
+    s.ft[c].tail<3>() = -Eigen::Vector3d(sd + ft_torque_[c]);
+  }
+  if (!options_.noise) return;
+  const SensorNoise& n = plant_.noise;
+  std::normal_distribution<double> g(0.0, 1.0);
+  for (int i = 0; i < kJoints; ++i) {
+    s.q[i] += n.joint_position * g(rng_);
+    s.dq[i] += n.joint_velocity * g(rng_);
+  }
+  const Eigen::Vector3d rot(g(rng_), g(rng_), g(rng_));
+  const Eigen::Vector3d drot = n.imu_orientation * rot;
+  if (drot.norm() > 0) {
+    s.imu_orientation = (s.imu_orientation * Eigen::Quaterniond(Eigen::AngleAxisd(drot.norm(), drot.normalized()))).normalized();
+  }
+  for (int k = 0; k < 3; ++k) {
+    s.imu_gyro[k] += n.gyro * g(rng_);
+    s.imu_accel[k] += n.accelerometer * g(rng_);
+  }
+  for (int c = 0; c < kContacts; ++c) {
+    for (int k = 0; k < 3; ++k) {
+      s.ft[c][k] += n.force * g(rng_);
+      s.ft[c][3 + k] += n.torque * g(rng_);
+    }
+  }
+}
+
+void Simulation::applyCommand(const Command& c) {
+  for (int i = 0; i < kJoints; ++i) {
+    const double current = std::isfinite(c.current[i]) ? c.current[i] : 0.0;
+    d_->ctrl[act_[i]] = k_t_[i] * current;  // MuJoCo clamps to ctrlrange
+  }
+}
+
+void Simulation::step() {
+  for (int k = 0; k < options_.substeps; ++k) {
+    mj_step(m_, d_);
+    if (ball_flying_) {
+      for (int i = 0; i < d_->ncon; ++i) {
+        if (m_->geom_bodyid[d_->contact[i].geom1] == ball_ || m_->geom_bodyid[d_->contact[i].geom2] == ball_) {
+          ball_flying_ = false;  // first touch: gravity acts again
+          d_->xfrc_applied[6 * ball_ + 2] = 0.0;
+          break;
+        }
+      }
+    }
+  }
+  // mj_step leaves sensordata of the state before its integration: refresh it for the new state.
+  mj_forward(m_, d_);
+}
+
+void Simulation::setTorsoForce(const Eigen::Vector3d& f) {
+  for (int k = 0; k < 6; ++k) d_->xfrc_applied[6 * torso_ + k] = k < 3 ? f[k] : 0.0;
+}
+
+VectorJ Simulation::appliedTorque() const {
+  VectorJ tau;
+  for (int i = 0; i < kJoints; ++i) tau[i] = d_->actuator_force[act_[i]];
+  return tau;
+}
+
+VectorJ Simulation::jointPositions() const {
+  VectorJ q;
+  for (int i = 0; i < kJoints; ++i) q[i] = d_->qpos[qadr_[i]];
+  return q;
+}
+
+double Simulation::torsoHeight() const { return d_->xpos[3 * torso_ + 2]; }
+
+double Simulation::torsoPitch() const {
+  const double* R = d_->xmat + 9 * torso_;  // row-major R_world_torso
+  return std::asin(std::clamp(-R[6], -1.0, 1.0));
+}
+
+double Simulation::torsoRoll() const {
+  const double* R = d_->xmat + 9 * torso_;
+  return std::atan2(R[7], R[8]);
+}
+
+Eigen::Vector3d Simulation::centerOfMass() const {
+  return Eigen::Vector3d(d_->subtree_com + 3 * torso_);  // the robot is the torso's subtree
+}
+
+bool Simulation::nonFootContact() const {
+  for (int i = 0; i < d_->ncon; ++i) {
+    const int b1 = m_->geom_bodyid[d_->contact[i].geom1], b2 = m_->geom_bodyid[d_->contact[i].geom2];
+    if (ball_ >= 0 && (b1 == ball_ || b2 == ball_)) continue;  // the push itself
+    for (int g : {d_->contact[i].geom1, d_->contact[i].geom2}) {
+      const int b = m_->geom_bodyid[g];
+      if (m_->body_rootid[b] != torso_) continue;  // not the robot (floor, other objects)
+      if (b != sole_body_[0] && b != sole_body_[1]) return true;
+    }
+  }
+  return false;
+}
+
+bool Simulation::ballTouchesRobot() const {
+  if (ball_ < 0) return false;
+  for (int i = 0; i < d_->ncon; ++i) {
+    const int b1 = m_->geom_bodyid[d_->contact[i].geom1], b2 = m_->geom_bodyid[d_->contact[i].geom2];
+    if ((b1 == ball_ && m_->body_rootid[b2] == torso_) || (b2 == ball_ && m_->body_rootid[b1] == torso_)) return true;
+  }
+  return false;
+}
+
+bool Simulation::feetTouch() const {
+  for (int i = 0; i < d_->ncon; ++i) {
+    const int b1 = m_->geom_bodyid[d_->contact[i].geom1], b2 = m_->geom_bodyid[d_->contact[i].geom2];
+    if ((b1 == sole_body_[0] && b2 == sole_body_[1]) || (b1 == sole_body_[1] && b2 == sole_body_[0])) return true;
+  }
+  return false;
+}
+
+Vector6 Simulation::wrenchInSole(int c, const Vector6& ft) const {
+  Vector6 w;
+  const Eigen::Vector3d f = R_sole_ft_[c] * ft.head<3>();
+  w.head<3>() = f;
+  w.tail<3>() = R_sole_ft_[c] * ft.tail<3>() + p_sole_ft_[c].cross(f);
+  return w;
+}
+
+Eigen::Vector2d Simulation::copInSole(int c, const Vector6& ft, double min_fz) const {
+  const Vector6 w = wrenchInSole(c, ft);
+  if (!(w[2] >= min_fz)) return Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+  // Moment about the sole origin of a force f at (x, y, 0): m_x = y f_z, m_y = -x f_z (z-parts of f
+  // acting in the sole plane only), so the CoP is (-m_y, m_x) / f_z.
+  return Eigen::Vector2d(-w[4] / w[2], w[3] / w[2]);
+}
+
+}  // namespace hqp::sim

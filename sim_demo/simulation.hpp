@@ -1,0 +1,116 @@
+#pragma once
+// The simulated Walker3: MuJoCo 2.2 scene (generated from the URDF, docs/simulation.md), the
+// 1 kHz sensor -> current loop's plant side. The controller side sees SensorData filled from
+// MuJoCo's sensors only (never the true state) and commands motor currents, which become joint
+// torques through the plant's torque constants. The ground-truth accessors exist for logs,
+// metrics and tests only.
+
+#include <mujoco/mujoco.h>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <random>
+#include <string>
+
+#include "plant_config.hpp"
+#include "tasks/sensor_data.hpp"
+#include "walker3_model.hpp"
+
+namespace hqp::sim {
+
+using Robot = walker3::Robot;
+constexpr int kJoints = Robot::nj;
+constexpr int kContacts = 2;  // left, right (the plant file's force_torque order)
+using Sensors = hqp::tasks::SensorData<kJoints, kContacts>;
+using Command = hqp::tasks::ActuatorCommand<kJoints>;
+using VectorJ = Eigen::Matrix<double, kJoints, 1>;
+using Vector6 = Eigen::Matrix<double, 6, 1>;
+
+struct SimulationOptions {
+  std::string scene;               // scene MJCF (build tree: includes the generated robot)
+  std::string plant;               // plant parameter file (robots/walker3/plant.yaml)
+  double control_dt = 0.001;       // s, one tick of the loop
+  int substeps = 1;                // physics steps per tick (physics dt = control_dt / substeps)
+  bool noise = false;              // add the plant file's Gaussian sensor noise
+  unsigned seed = 1;               // noise seed
+  double hip_pitch = -0.3, knee = 0.6, ankle_pitch = -0.3;  // standing pose (rad), both legs
+};
+
+class Simulation {
+ public:
+  explicit Simulation(const SimulationOptions& options);  // throws std::runtime_error
+  ~Simulation();
+  Simulation(const Simulation&) = delete;
+  Simulation& operator=(const Simulation&) = delete;
+
+  // Standing pose, torso upright, both soles on the floor, at rest, t = 0, zero command.
+  void reset();
+  // SensorData from MuJoCo's sensors (encoders, IMU, F/T), plus noise if enabled. The values
+  // belong to the current state with the previous command's torques (zero-order hold).
+  void readSensors(Sensors& s);
+  // Joint torque = k_t · current, clamped to the motor's ctrlrange (URDF effort). A non-finite
+  // current is applied as zero.
+  void applyCommand(const Command& c);
+  // One control period (substeps physics steps), then recompute the sensors.
+  void step();
+  // External force (world, N) at the torso's centre of mass until changed (pushes).
+  void setTorsoForce(const Eigen::Vector3d& f);
+  // The scene's 5 kg ball (body "ball"), if it has one: thrown horizontally with momentum
+  // `momentum` (N·s, world; m v) at the torso's centre of mass from `distance` m away. It flies
+  // straight (gravity cancelled by an applied force) until it first touches something; then it
+  // is an ordinary body. The impulse the robot receives is what the ball loses: ballMomentum()
+  // before minus after.
+  bool hasBall() const { return ball_ >= 0; }
+  void launchBall(const Eigen::Vector3d& momentum, double distance = 0.6);
+  Eigen::Vector3d ballMomentum() const;     // N·s, world (zero without a ball)
+  bool ballTouchesRobot() const;
+
+  double time() const { return d_->time; }
+  double controlDt() const { return options_.control_dt; }
+  const mjModel* model() const { return m_; }
+  mjData* data() { return d_; }
+  const PlantConfig& plant() const { return plant_; }
+  const VectorJ& torqueConstant() const { return k_t_; }
+  const VectorJ& standingPose() const { return q_stand_; }
+  int jointQposAdr(int i) const { return qadr_[i]; }   // model joint i -> qpos index
+  int jointDofAdr(int i) const { return dofadr_[i]; }  // model joint i -> qvel index
+  int actuator(int i) const { return act_[i]; }        // model joint i -> actuator id
+  int baseQposAdr() const { return base_qadr_; }       // free joint: position, quaternion w x y z
+  int baseDofAdr() const { return base_dofadr_; }      // free joint: linear (world), angular (body)
+
+  // Ground truth (logs, metrics, tests; never for the controller).
+  VectorJ appliedTorque() const;            // N·m, actuator output after the ctrlrange clamp
+  VectorJ jointPositions() const;
+  double torsoHeight() const;               // torso frame z (m)
+  double torsoPitch() const;                // rad, about world y (+: leaning forward)
+  double torsoRoll() const;                 // rad, about world x
+  Eigen::Vector3d centerOfMass() const;     // m, world
+  bool nonFootContact() const;              // a robot geom other than a sole plate is in contact
+  bool feetTouch() const;                   // the two sole plates touch each other (corrupts the F/T CoP)
+
+  // Centre of pressure in the sole frame (x, y) from a SensorData F/T wrench (support on foot,
+  // sensor frame, about the sensor origin). NaN when f_z < min_fz.
+  Eigen::Vector2d copInSole(int c, const Vector6& ft, double min_fz = 10.0) const;
+  // Sole-frame wrench (moment about the sole origin) from the same F/T wrench.
+  Vector6 wrenchInSole(int c, const Vector6& ft) const;
+
+ private:
+  int sensorAdr(const std::string& name, int dim) const;
+
+  SimulationOptions options_;
+  PlantConfig plant_;
+  mjModel* m_ = nullptr;
+  mjData* d_ = nullptr;
+  VectorJ k_t_, q_stand_;
+  std::array<int, kJoints> qadr_{}, dofadr_{}, act_{}, jpos_{}, jvel_{};
+  int imu_quat_ = 0, imu_gyro_ = 0, imu_accel_ = 0, torso_ = 0, base_qadr_ = 0, base_dofadr_ = 0;
+  int ball_ = -1, ball_qadr_ = 0, ball_dofadr_ = 0;
+  bool ball_flying_ = false;
+  std::array<int, kContacts> ft_force_{}, ft_torque_{}, sole_body_{};
+  std::array<Eigen::Matrix3d, kContacts> R_sole_ft_;  // F/T frame axes in the sole frame
+  std::array<Eigen::Vector3d, kContacts> p_sole_ft_;  // F/T origin in the sole frame
+  std::mt19937 rng_;
+};
+
+}  // namespace hqp::sim

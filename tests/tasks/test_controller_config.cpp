@@ -1,0 +1,194 @@
+// Configuration: the shipped robots/walker3/controller.yaml loads and agrees with
+// the URDF (read here as text, independently of the generated model), and broken
+// files are rejected with a message that names the file and the offending key.
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <regex>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include "tasks/controller_config_yaml.hpp"
+#include "walker3_model.hpp"
+
+namespace {
+
+using Robot = walker3::Robot;
+using Config = hqp::tasks::ControllerConfig<Robot::nj>;
+
+const std::string kYaml = std::string(HQP_SOURCE_DIR) + "/robots/walker3/controller.yaml";
+const std::string kUrdf = std::string(HQP_SOURCE_DIR) + "/robots/walker3/walker3.urdf";
+
+std::string readText(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Attribute `attr` of the element `tag` (limit, dynamics) inside <joint name="joint">.
+double urdfJointAttribute(const std::string& joint, const std::string& tag, const std::string& attr) {
+  const std::string urdf = readText(kUrdf);
+  const std::size_t start = urdf.find("<joint name=\"" + joint + "\"");
+  if (start == std::string::npos) return std::nan("");
+  const std::size_t end = urdf.find("</joint>", start);
+  const std::string block = urdf.substr(start, end - start);
+  std::smatch m;
+  if (!std::regex_search(block, m, std::regex("<" + tag + "[^>]*\\s" + attr + "=\"([^\"]+)\""))) {
+    return std::nan("");
+  }
+  return std::stod(m[1].str());
+}
+
+// The shipped file with one edit, written to a temporary file.
+class EditedConfig {
+ public:
+  EditedConfig(const std::string& from, const std::string& to) {
+    std::string text = readText(kYaml);
+    const std::size_t at = text.find(from);
+    found_ = at != std::string::npos;
+    if (found_) text.replace(at, from.size(), to);
+    path_ = ::testing::TempDir() + "controller_" + std::to_string(::getpid()) + "_" +
+            std::to_string(counter_++) + ".yaml";
+    std::ofstream(path_) << text;
+  }
+  ~EditedConfig() { std::remove(path_.c_str()); }
+  const std::string& path() const { return path_; }
+  bool found() const { return found_; }
+
+ private:
+  static inline int counter_ = 0;
+  std::string path_;
+  bool found_ = false;
+};
+
+// The error message of loading `path`, or "" if it loads.
+std::string loadError(const std::string& path) {
+  try {
+    hqp::tasks::loadControllerConfig<Robot>(path);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+void expectRejected(const std::string& from, const std::string& to,
+                    const std::string& must_name) {
+  EditedConfig f(from, to);
+  ASSERT_TRUE(f.found()) << "test edit not applicable: " << from;
+  const std::string msg = loadError(f.path());
+  EXPECT_NE(msg.find(f.path()), std::string::npos) << msg;
+  EXPECT_NE(msg.find(must_name), std::string::npos) << "expected '" << must_name << "' in: " << msg;
+}
+
+TEST(ControllerConfig, ShippedFileLoads) {
+  const Config c = hqp::tasks::loadControllerConfig<Robot>(kYaml);
+  EXPECT_EQ(c.solver, Config::Solver::Hqp);
+  EXPECT_EQ(c.dt, 0.001);
+  EXPECT_EQ(c.balance.mu, 0.6);
+  EXPECT_EQ(c.balance.com.kp, 100.0);
+  EXPECT_EQ(c.balance.com.kd, 20.0);
+  EXPECT_EQ(c.estimator.contact_threshold, 30.0);
+  EXPECT_EQ(c.joint.leak_time, 0.5);
+  EXPECT_LT(c.balance.sole_x_min, c.balance.sole_x_max);
+  EXPECT_GE(c.balance.sole_x_min, c.planner.sole_x_min);  // CoP region inside the sole
+  EXPECT_LE(c.balance.sole_y_max, c.planner.sole_y_max);
+  EXPECT_GT(c.safe.max_tilt, 0.0);
+}
+
+TEST(ControllerConfig, KneeTorqueLimitIsTheUrdfEffort) {
+  const Config c = hqp::tasks::loadControllerConfig<Robot>(kYaml);
+  EXPECT_EQ(urdfJointAttribute("l_knee", "limit", "effort"), 250.0);
+  EXPECT_EQ(c.balance.tau_max[Robot::Joints::l_knee], 250.0);
+  EXPECT_EQ(c.balance.tau_max[Robot::Joints::r_knee], 250.0);
+}
+
+TEST(ControllerConfig, PerJointValuesMatchTheUrdfByName) {
+  const Config c = hqp::tasks::loadControllerConfig<Robot>(kYaml);
+  for (const char* side : {"l_", "r_"}) {
+    for (const char* j : {"hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_roll"}) {
+      const std::string name = std::string(side) + j;
+      const int k = Robot::jointIndex(name);
+      ASSERT_GE(k, 0) << name;
+      const double effort = urdfJointAttribute(name, "limit", "effort");
+      EXPECT_EQ(c.balance.tau_max[k], effort) << name;
+      // The current clamp is the same torque as the limit.
+      EXPECT_NEAR(c.joint.current_limit[k] * c.joint.torque_constant[k], effort, 1e-9) << name;
+      EXPECT_EQ(c.joint.friction[static_cast<std::size_t>(k)].coulomb,
+                urdfJointAttribute(name, "dynamics", "friction")) << name;
+      EXPECT_EQ(c.joint.friction[static_cast<std::size_t>(k)].viscous,
+                urdfJointAttribute(name, "dynamics", "damping")) << name;
+      EXPECT_GT(c.joint.friction[static_cast<std::size_t>(k)].dq_star, 0.0);
+      EXPECT_GE(c.joint.k_f[k], 0.0);
+      EXPECT_LE(c.joint.k_f[k], 1.0);
+    }
+  }
+}
+
+TEST(ControllerConfig, MissingKeyNamesKeyAndFile) {
+  expectRejected("  mu: 0.6", "  # mu removed", "balance.mu");
+  expectRejected("  max_tilt: 0.8", "  # gone", "safe_mode.max_tilt");
+  expectRejected("{kp: 100, kd: 20}", "{kp: 100}", "balance.com.kd");
+  expectRejected("    r_knee:         250", "    # r_knee", "balance.torque_limit.r_knee");
+  expectRejected("torque_constant: 5, current_limit: 16", "current_limit: 16",  // the left one
+                 "joint_control.joints.l_ankle_roll.torque_constant");
+}
+
+TEST(ControllerConfig, UnknownJointIsNamed) {
+  expectRejected("    l_knee:         {torque_constant", "    l_kneee:        {torque_constant",
+                 "unknown joint 'l_kneee'");
+  expectRejected("    r_hip_yaw:      100", "    r_hip_yawn:     100", "unknown joint 'r_hip_yawn'");
+}
+
+TEST(ControllerConfig, UnknownKeyIsRejected) {
+  expectRejected("  mu: 0.6", "  muu: 0.6", "balance.muu");
+  expectRejected("dq_star: 0.05, k_f: 0.8", "dq_star: 0.05, kf: 0.8", "kf");
+}
+
+TEST(ControllerConfig, NegativeOrInvalidValuesAreRejected) {
+  expectRejected("{kp: 100, kd: 20}", "{kp: -100, kd: 20}", "balance.com.kp");
+  expectRejected("torso:        {kp: 200, kd: 28.28}", "torso:        {kp: 200, kd: -1}",
+                 "balance.torso.kd");
+  expectRejected("k_dq: 20}", "k_dq: -20}", "joint_control.joints.l_knee.k_dq");
+  expectRejected("  mu: 0.6", "  mu: abc", "balance.mu");
+  expectRejected("  dt: 0.001", "  dt: 0", "controller.dt");
+  expectRejected("  solver: hqp", "  solver: lqp", "controller.solver");
+  expectRejected("    l_knee:         250", "    l_knee:         300", "balance.torque_limit.l_knee");
+  expectRejected("x_min: -0.10, x_max: 0.10", "x_min: 0.10, x_max: -0.10", "balance.cop_region");
+  expectRejected("  mu: 0.6", "  mu: .nan", "balance.mu");
+}
+
+TEST(ControllerConfig, OtherSolverAndInfiniteLeakLoad) {
+  EditedConfig f("  solver: hqp", "  solver: wqp");
+  ASSERT_TRUE(f.found());
+  EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(f.path()).solver, Config::Solver::Wqp);
+  EditedConfig g("  leak_time: 0.5", "  leak_time: .inf");
+  ASSERT_TRUE(g.found());
+  EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(g.path()).joint.leak_time,
+            std::numeric_limits<double>::infinity());
+}
+
+TEST(ControllerConfig, MissingOrBrokenFileNamesTheFile) {
+  const std::string missing = ::testing::TempDir() + "no_such_controller.yaml";
+  const std::string msg = loadError(missing);
+  EXPECT_NE(msg.find(missing), std::string::npos) << msg;
+  EditedConfig broken("controller:", "controller: [");
+  ASSERT_TRUE(broken.found());
+  const std::string msg2 = loadError(broken.path());
+  EXPECT_NE(msg2.find(broken.path()), std::string::npos) << msg2;
+}
+
+TEST(ControllerConfig, DefaultConfigFollowsTheModel) {
+  const Config c = hqp::tasks::defaultControllerConfig<Robot>();
+  EXPECT_EQ(c.balance.tau_max[Robot::Joints::l_knee], 250.0);
+  EXPECT_EQ(c.joint.friction[Robot::Joints::l_knee].coulomb, 5.0);
+  EXPECT_EQ(c.joint.current_limit[Robot::Joints::l_knee], 250.0);
+}
+
+}  // namespace

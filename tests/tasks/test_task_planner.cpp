@@ -1,0 +1,216 @@
+// The task planner of Section III-A on the Walker3 model: the safe-region rule (follow /
+// hold, both margins, contact flag, NaN), the CoM midpoint + C rule, the mean velocity, the
+// upright torso at the feet's heading, F_ref = m g / 2, and reset(). Expected values are
+// closed forms of the crouch in robots/walker3/README.md (soles at (0.02, ±0.09, 0) below a
+// base at the origin of x and y) and that file's MuJoCo figures.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "model/configuration.hpp"
+#include "tasks/contact_layout.hpp"
+#include "tasks/task_planner.hpp"
+#include "walker3_model.hpp"
+
+namespace {
+
+using Robot = walker3::Robot;
+using Dyn = hqp::tasks::ContactLayout<Robot, 2, 6>::Dynamics;
+using VectorQ = Eigen::Matrix<double, Robot::nq, 1>;
+using VectorV = Eigen::Matrix<double, Robot::nv, 1>;
+using Refs = hqp::tasks::References<2>;
+using Cop = std::array<Eigen::Vector2d, 2>;
+
+constexpr double kBaseHeight = 0.976055732;  // crouch, soles on z = 0 (README, MuJoCo)
+constexpr double kSoleX = 0.02, kSoleY = 0.09;
+
+// The README crouch: hip pitch −0.3, knee 0.6, ankle pitch −0.3; base at (x, y, 0.976) with yaw.
+VectorQ crouch(double x = 0.0, double y = 0.0, double yaw = 0.0) {
+  VectorQ q = hqp::model::neutralConfiguration<Robot>();
+  q(0) = x;
+  q(1) = y;
+  q(2) = kBaseHeight;
+  q(3) = std::cos(0.5 * yaw);
+  q(6) = std::sin(0.5 * yaw);
+  for (int j : {Robot::Joints::l_hip_pitch, Robot::Joints::r_hip_pitch}) q(7 + j) = -0.3;
+  for (int j : {Robot::Joints::l_knee, Robot::Joints::r_knee}) q(7 + j) = 0.6;
+  for (int j : {Robot::Joints::l_ankle_pitch, Robot::Joints::r_ankle_pitch}) q(7 + j) = -0.3;
+  return q;
+}
+
+class Planner : public ::testing::Test {
+ protected:
+  Planner() : dyn({Robot::Frames::l_sole, Robot::Frames::r_sole, Robot::Frames::imu}) {
+    params.safe_margin = 0.02;
+    params.com_height = 0.8;
+    params.sole_x_min = -0.11;
+    params.sole_x_max = 0.11;
+    params.sole_y_min = -0.05;
+    params.sole_y_max = 0.05;
+    planner.configure(params, Robot::total_mass);
+  }
+  void at(const VectorQ& q, const VectorV& v = VectorV::Zero()) { dyn.calcWbcDependence(q, v); }
+  void step(const Cop& cop, std::array<bool, 2> contact = {true, true}) {
+    planner.update(dyn, cop, contact, refs);
+  }
+
+  Dyn dyn;
+  hqp::tasks::PlannerParameters params;
+  hqp::tasks::TaskPlanner<2> planner;
+  Refs refs;
+  Cop centre{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
+};
+
+TEST_F(Planner, CrouchGeometry) {
+  // Premise of the closed forms below, on the model.
+  at(crouch());
+  EXPECT_LT((dyn.placement(0).translation() - Eigen::Vector3d(kSoleX, kSoleY, 0)).norm(), 1e-8);
+  EXPECT_LT((dyn.placement(1).translation() - Eigen::Vector3d(kSoleX, -kSoleY, 0)).norm(), 1e-8);
+}
+
+TEST_F(Planner, FollowsFeetWithZmpInSafeRegion) {
+  at(crouch());
+  step(centre);
+  for (int c = 0; c < 2; ++c) {
+    EXPECT_TRUE(planner.inSafeRegion(c));
+    EXPECT_TRUE(refs.contact_pose[c].matrix().isApprox(dyn.placement(c).matrix(), 1e-15));
+    EXPECT_TRUE(refs.contact_velocity[c].isZero(0.0));
+    EXPECT_TRUE(refs.contact_acceleration[c].isZero(0.0));
+  }
+  // The robot moves 5 cm forward with both ZMPs well inside: the references follow.
+  at(crouch(0.05));
+  step(centre);
+  EXPECT_NEAR(refs.contact_pose[0].translation().x(), kSoleX + 0.05, 1e-8);
+  EXPECT_NEAR(refs.contact_pose[1].translation().x(), kSoleX + 0.05, 1e-8);
+}
+
+TEST_F(Planner, ComIsMidpointOfFeetPlusC) {
+  at(crouch());
+  step(centre);
+  EXPECT_NEAR(refs.com.x(), kSoleX, 1e-8);
+  EXPECT_NEAR(refs.com.y(), 0.0, 1e-8);
+  EXPECT_NEAR(refs.com.z(), 0.0 + params.com_height, 1e-8);
+  EXPECT_TRUE(refs.com_velocity.isZero(0.0));
+  EXPECT_TRUE(refs.com_acceleration.isZero(0.0));
+}
+
+TEST_F(Planner, AutomaticCIsTheCoMHeightOfTheStartPose) {
+  params.com_height = 0.0;
+  planner.configure(params, Robot::total_mass);
+  at(crouch());
+  step(centre);
+  EXPECT_NEAR(planner.comHeight(), 0.83812, 1e-5);  // README: CoM z in the crouch (MuJoCo)
+  EXPECT_NEAR(refs.com.z(), 0.83812, 1e-5);
+}
+
+TEST_F(Planner, ForceReferenceIsHalfTheWeight) {
+  at(crouch());
+  step(centre);
+  for (int c = 0; c < 2; ++c) {
+    hqp::model::Vector6 expected = hqp::model::Vector6::Zero();
+    expected(2) = 43.0 * 9.81 / 2.0;
+    EXPECT_LT((refs.contact_force[c] - expected).norm(), 1e-9);
+  }
+}
+
+TEST_F(Planner, TorsoUprightAtTheFeetHeading) {
+  at(crouch());
+  step(centre);
+  EXPECT_TRUE(refs.torso_orientation.isIdentity(1e-12));
+  EXPECT_TRUE(refs.torso_angular_velocity.isZero(0.0));
+  // Whole robot turned by 0.4 rad and moved: torso reference turned with it, still upright;
+  // the CoM reference is the rotated midpoint.
+  planner.reset();
+  const double yaw = 0.4;
+  at(crouch(0.3, -0.2, yaw));
+  step(centre);
+  const Eigen::Matrix3d Rz = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  EXPECT_TRUE(refs.torso_orientation.isApprox(Rz, 1e-12));
+  const Eigen::Vector3d mid = Eigen::Vector3d(0.3, -0.2, 0) + Rz * Eigen::Vector3d(kSoleX, 0, 0);
+  EXPECT_NEAR(refs.com.x(), mid.x(), 1e-8);
+  EXPECT_NEAR(refs.com.y(), mid.y(), 1e-8);
+}
+
+TEST_F(Planner, HoldsFootWhoseZmpLeavesTheSafeRegion) {
+  at(crouch());
+  step(centre);
+  at(crouch(0.05));
+  // Left ZMP 1 mm beyond the front margin (0.11 − 0.02 = 0.09), right ZMP 0.1 mm inside it.
+  step({Eigen::Vector2d(0.091, 0.0), Eigen::Vector2d(0.0899, 0.0)});
+  EXPECT_FALSE(planner.inSafeRegion(0));
+  EXPECT_TRUE(planner.inSafeRegion(1));
+  EXPECT_NEAR(refs.contact_pose[0].translation().x(), kSoleX, 1e-8);          // held
+  EXPECT_NEAR(refs.contact_pose[1].translation().x(), kSoleX + 0.05, 1e-8);   // follows
+  EXPECT_TRUE(refs.contact_velocity[0].isZero(0.0));
+  // The CoM reference uses the held reference: midpoint of 0.02 and 0.07.
+  EXPECT_NEAR(refs.com.x(), kSoleX + 0.025, 1e-8);
+  // Back at the centre: follows again.
+  step(centre);
+  EXPECT_TRUE(planner.inSafeRegion(0));
+  EXPECT_NEAR(refs.contact_pose[0].translation().x(), kSoleX + 0.05, 1e-8);
+}
+
+TEST_F(Planner, SafeRegionMarginsOnEverySide) {
+  at(crouch());
+  const double m = params.safe_margin;
+  const struct { Eigen::Vector2d zmp; bool safe; } cases[] = {
+      {{0.11 - m - 1e-4, 0.0}, true},  {{0.11 - m + 1e-4, 0.0}, false},
+      {{-0.11 + m + 1e-4, 0.0}, true}, {{-0.11 + m - 1e-4, 0.0}, false},
+      {{0.0, 0.05 - m - 1e-4}, true},  {{0.0, 0.05 - m + 1e-4}, false},
+      {{0.0, -0.05 + m + 1e-4}, true}, {{0.0, -0.05 + m - 1e-4}, false},
+  };
+  for (const auto& k : cases) {
+    step({k.zmp, Eigen::Vector2d::Zero()});
+    EXPECT_EQ(planner.inSafeRegion(0), k.safe) << k.zmp.transpose();
+    EXPECT_TRUE(planner.inSafeRegion(1));
+  }
+}
+
+TEST_F(Planner, HoldsFootOutOfContactOrWithNonFiniteZmp) {
+  at(crouch());
+  step(centre);
+  at(crouch(0.05));
+  step(centre, {false, true});
+  EXPECT_FALSE(planner.inSafeRegion(0));
+  EXPECT_NEAR(refs.contact_pose[0].translation().x(), kSoleX, 1e-8);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  step({Eigen::Vector2d(nan, 0.0), Eigen::Vector2d(0.0, nan)});
+  EXPECT_FALSE(planner.inSafeRegion(0));
+  EXPECT_FALSE(planner.inSafeRegion(1));
+  EXPECT_NEAR(refs.contact_pose[0].translation().x(), kSoleX, 1e-8);
+  EXPECT_NEAR(refs.contact_pose[1].translation().x(), kSoleX + 0.05, 1e-8);
+  EXPECT_TRUE(refs.com.allFinite());
+}
+
+TEST_F(Planner, ComVelocityIsTheMeanFootVelocity) {
+  // Every frame of a robot translating rigidly (base twist only, identity orientation) moves
+  // with the base velocity: both feet and so their mean.
+  VectorV v = VectorV::Zero();
+  v.head<3>() << 0.1, -0.2, 0.05;
+  at(crouch(), v);
+  step(centre);
+  for (int c = 0; c < 2; ++c) {
+    EXPECT_LT((refs.contact_velocity[c].head<3>() - v.head<3>()).norm(), 1e-12);
+    EXPECT_LT(refs.contact_velocity[c].tail<3>().norm(), 1e-12);
+  }
+  EXPECT_LT((refs.com_velocity - v.head<3>()).norm(), 1e-12);
+  // One foot held (zero velocity reference): the mean halves.
+  step({Eigen::Vector2d(0.1, 0.0), Eigen::Vector2d::Zero()});
+  EXPECT_LT((refs.com_velocity - 0.5 * v.head<3>()).norm(), 1e-12);
+}
+
+TEST_F(Planner, ResetReinitialisesFromTheState) {
+  at(crouch());
+  step(centre);
+  at(crouch(0.05));
+  step({Eigen::Vector2d(0.1, 0.0), Eigen::Vector2d(0.1, 0.0)});  // both held
+  EXPECT_NEAR(refs.contact_pose[0].translation().x(), kSoleX, 1e-8);
+  planner.reset();
+  step({Eigen::Vector2d(0.1, 0.0), Eigen::Vector2d(0.1, 0.0)});  // still outside, but re-initialised
+  EXPECT_NEAR(refs.contact_pose[0].translation().x(), kSoleX + 0.05, 1e-8);
+  EXPECT_NEAR(refs.contact_pose[1].translation().x(), kSoleX + 0.05, 1e-8);
+  EXPECT_FALSE(planner.inSafeRegion(0));
+}
+
+}  // namespace
