@@ -15,18 +15,10 @@
 
 #include "hqp/hqp_wbc.hpp"
 #include "hqp/wqp_wbc.hpp"
+#include "support/allocation_counter.hpp"
 
-namespace {
-std::atomic<long> g_news{0};
-}  // namespace
-
-void* operator new(std::size_t n) {
-  g_news.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+using hqp::testing::g_counting;
+using hqp::testing::g_news;
 
 namespace {
 

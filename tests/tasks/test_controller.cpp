@@ -15,26 +15,10 @@
 #include "support/walker3_standing.hpp"
 #include "tasks/controller.hpp"
 #include "tasks/controller_config_yaml.hpp"
+#include "support/allocation_counter.hpp"
 
-namespace {
-std::atomic<long> g_news{0};
-std::atomic<bool> g_counting{false};
-}  // namespace
-
-void* operator new(std::size_t size) {
-  if (g_counting) ++g_news;
-  if (void* p = std::malloc(size ? size : 1)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) {
-  if (g_counting) ++g_news;
-  if (void* p = std::malloc(size ? size : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+using hqp::testing::g_counting;
+using hqp::testing::g_news;
 
 namespace {
 
