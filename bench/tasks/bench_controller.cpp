@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <memory>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "support/walker3_standing.hpp"
@@ -66,6 +67,8 @@ void BM_Tick(benchmark::State& state) {
   constexpr int kStages = static_cast<int>(Stage::Count);
   std::vector<std::vector<double>> t(kStages);
   for (auto& v : t) v.reserve(1 << 20);
+  std::vector<std::vector<double>> level_t(Controller::num_levels);
+  for (auto& v : level_t) v.reserve(1 << 20);
   std::size_t k = 0;
   long safe = 0, non_optimal = 0;
   for (auto _ : state) {
@@ -73,6 +76,7 @@ void BM_Tick(benchmark::State& state) {
     benchmark::DoNotOptimize(cmd.current.data());
     const auto& d = ctrl->diagnostics();
     for (int st = 0; st < kStages; ++st) t[st].push_back(d.time_us[st]);
+    for (int p = 0; p < Controller::num_levels; ++p) level_t[p].push_back(d.levels[p].time_us);
     if (d.mode != hqp::tasks::ControllerMode::Balance) {
       ++safe;
       ctrl->reset();
@@ -87,6 +91,9 @@ void BM_Tick(benchmark::State& state) {
     if (st == static_cast<int>(Stage::Solve) || st == static_cast<int>(Stage::Total))
       state.counters[std::string(names[st]) + "_p999_us"] = percentile(t[st], 0.999);
   }
+  if (solver == Controller::Config::Solver::Hqp)
+    for (int p = 0; p < Controller::num_levels; ++p)
+      state.counters["level" + std::to_string(p + 1) + "_p50_us"] = percentile(level_t[p], 0.5);
   state.counters["safe_mode_ticks"] = static_cast<double>(safe);
   state.counters["non_optimal_ticks"] = static_cast<double>(non_optimal);
   state.SetLabel(solver == Controller::Config::Solver::Hqp ? "HqpWbc" : "WqpWbc");

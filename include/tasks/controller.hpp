@@ -206,6 +206,7 @@ class Controller {
         dst.iterations = src.iterations;
         dst.rank = src.rank;
         dst.num_active = src.num_active;
+        dst.time_us = src.time_us;
         for (int k = 0; k < src.num_active; ++k) dst.active_row[k] = src.active_row[k];
       }
     } else {
@@ -217,6 +218,7 @@ class Controller {
         dst.iterations = r.iterations;
         dst.rank = 0;
         dst.num_active = 0;
+        dst.time_us = 0.0;
       }
       for (int k = 0; k < r.num_active; ++k) {
         const int row = r.active_row[k];

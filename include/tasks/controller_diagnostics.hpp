@@ -47,6 +47,7 @@ struct LevelDiagnostics {
   int rank = 0;           // rank of the projected task (HqpWbc only; 0 for WqpWbc)
   int num_active = 0;     // constraint rows at a bound
   std::array<int, MaxActive> active_row{};  // index into the stacked constraint rows
+  double time_us = 0.0;   // this level's solve time (HqpWbc only; 0 for WqpWbc, one QP)
 };
 
 template <int NumLevels, int NumContacts, int MaxActive>

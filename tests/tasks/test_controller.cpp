@@ -96,6 +96,14 @@ TEST_P(ControllerStanding, TorquesAreGravityCompensationAndZmpAtSoleCentre) {
     EXPECT_LT(d.zmp_measured[c].norm(), 1e-9);
   }
   EXPECT_GT(d.time_us[static_cast<int>(hqp::tasks::Stage::Total)], 0.0);
+  if (hqp) {  // per-level solve times are parts of the solve stage
+    double levels_us = 0.0;
+    for (int p = 0; p < Controller::num_levels; ++p) {
+      EXPECT_GT(d.levels[p].time_us, 0.0) << "level " << p;
+      levels_us += d.levels[p].time_us;
+    }
+    EXPECT_LE(levels_us, d.time_us[static_cast<int>(hqp::tasks::Stage::Solve)]);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Solvers, ControllerStanding,
