@@ -10,7 +10,10 @@
 //     with sensor noise;
 //  3. the log is filtered, differentiated and fitted (weighted LS);
 //  4. a different trajectory validates: torque prediction error per joint,
-//     CAD (URDF inertias, no friction: "the 3D model" of the paper) vs identified.
+//     CAD (URDF inertias, no friction: "the 3D model" of the paper) vs identified,
+//     RMS over all samples of the run (stuck ones included). The validation
+//     trajectory is a random Fourier series per joint, scaled to the URDF
+//     limits and chosen, from the reference alone, to keep every joint moving.
 // Writes the logs (hqp_identify's CSV format), the identified YAML and the
 // validation torques for a plot like the paper's Fig. 7 into --out-dir.
 // Prints on how many joints the target (validation RMS below 1 N·m and
@@ -145,6 +148,58 @@ void writeFig7Svg(const std::string& path, const Eigen::VectorXd& t, const Eigen
   out << "<text x='" << W / 2 << "' y='" << H * panels + 25 << "'>time (s)</text>\n</svg>\n";
 }
 
+// Scales each joint's motion about q0 (linear in its coefficients, rest at the
+// ends kept) up or down to its tightest URDF limit (position, velocity,
+// acceleration) on a dense grid: the validation then keeps every joint as far
+// from rest as the limits allow, so that stiction, which eq. 7 cannot predict,
+// takes little of it.
+void scaleToLimits(hi::FourierTrajectory& traj, const hi::JointLimits& L, double margin) {
+  const int n = traj.joints(), N = 4000;
+  Eigen::VectorXd q(n), dq(n), ddq(n);
+  Eigen::VectorXd up = Eigen::VectorXd::Zero(n), down = up, vmax = up, amax = up;
+  for (int k = 0; k < N; ++k) {
+    traj.evaluate(traj.period() * k / N, q, dq, ddq);
+    for (int j = 0; j < n; ++j) {
+      up[j] = std::max(up[j], q[j] - traj.q0(j));
+      down[j] = std::max(down[j], traj.q0(j) - q[j]);
+      vmax[j] = std::max(vmax[j], std::abs(dq[j]));
+      amax[j] = std::max(amax[j], std::abs(ddq[j]));
+    }
+  }
+  for (int j = 0; j < n; ++j) {
+    double k = 1e9;
+    const bool bounded = std::isfinite(L.q_min[j]) && std::isfinite(L.q_max[j]);
+    if (bounded && up[j] + down[j] > 0.0) k = std::min(k, (L.q_max[j] - L.q_min[j]) / (up[j] + down[j]));
+    if (vmax[j] > 0.0) k = std::min(k, L.dq_max[j] / vmax[j]);
+    if (amax[j] > 0.0) k = std::min(k, L.ddq_max[j] / amax[j]);
+    if (!(k < 1e9)) continue;
+    // The scaled motion spans [q0 − k·down, q0 + k·up]: centre it in the range.
+    if (bounded) traj.q0(j) = 0.5 * (L.q_min[j] + L.q_max[j]) - 0.5 * margin * k * (up[j] - down[j]);
+    traj.scaleJoint(j, margin * k);
+  }
+}
+
+// Per joint, the share of one period during which the reference stays within
+// e0[j] of its last turning point (or of its start, at rest): a geared joint
+// sticks there until the tracking error builds the breakaway torque, and eq. 7
+// cannot predict a stuck joint's torque. A kinematic estimate from the
+// reference alone (never from the rig's response).
+Eigen::VectorXd stuckShare(const hi::FourierTrajectory& traj, const Eigen::VectorXd& e0) {
+  const int n = traj.joints(), N = 10000;
+  Eigen::VectorXd q(n), dq(n), ddq(n), share = Eigen::VectorXd::Zero(n);
+  traj.evaluate(0.0, q, dq, ddq);
+  Eigen::VectorXd turn = q, last_dq = dq;
+  for (int k = 0; k < N; ++k) {
+    traj.evaluate(traj.period() * k / N, q, dq, ddq);
+    for (int j = 0; j < n; ++j) {
+      if (dq[j] * last_dq[j] < 0.0) turn[j] = q[j];
+      if (dq[j] != 0.0) last_dq[j] = dq[j];
+      share[j] += std::abs(q[j] - turn[j]) < e0[j] ? 1.0 / N : 0.0;
+    }
+  }
+  return share;
+}
+
 void writeLog(const std::string& path, const hi::JointLog& log) {
   std::ofstream out(path);
   out << "time";
@@ -175,6 +230,8 @@ int main(int argc, char** argv) {
   Noise noise;
   double pd_hz = 20.0;
   double friction_timeconst = 0.004;
+  double val_fill = 0.95;
+  int val_candidates = 50;
   hi::FitSettings fs;
   fs.min_speed = 0.05;
   app.add_option("--urdf", urdf, "Walker3 URDF")->capture_default_str();
@@ -190,6 +247,12 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--friction-timeconst", friction_timeconst,
                  "time constant of MuJoCo's frictionloss constraint (s)")->capture_default_str();
+  app.add_option("--validation-fill", val_fill,
+                 "validation: scale each joint to this fraction of its tightest limit")
+      ->capture_default_str();
+  app.add_option("--validation-candidates", val_candidates,
+                 "validation: random trajectories drawn, the one moving most is run")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
   std::vector<std::string> links;
@@ -209,10 +272,74 @@ int main(int argc, char** argv) {
   std::printf("base parameters: %d of %d\n", bp.rank, hm::RegressorSizes<Robot>::np);
   std::printf("excitation: condition number %.1f -> %.1f (%d evaluations)\n", ex.cond_initial,
               ex.cond_final, ex.evaluations);
-  // Validation: another optimized trajectory, from a different random start.
-  es.seed = 1000 + seed;
+  // Validation: a different Fourier trajectory (same 5 harmonics and period),
+  // not optimized for conditioning but for motion. Per joint, of
+  // `val_candidates` random draws (coefficients ~ N(0, l^p), p cycling through
+  // −1…2; every second draw without the first harmonic), each scaled and
+  // centred to the joint's tightest URDF limit, the one with the least
+  // estimated stuck time (stuckShare) is kept. The breakaway tracking error of
+  // a joint is what the PD needs beyond the feedforward's URDF friction to
+  // reach the top of the rig's Coulomb range (5 N m): (5 − F_urdf) / k_p, with
+  // k_p from the CAD inertia at mid-range (the gains of run()). A priori
+  // figures only, not the plant's friction.
   hi::FourierTrajectory validation(Robot::nj, es.fourier);
-  hi::optimizeExcitation<Robot>(bp, limits, es, validation);
+  Eigen::VectorXd e_break(Robot::nj);
+  {
+    hm::Data<Robot> d;
+    typename hm::Data<Robot>::VectorQ qm;
+    for (int j = 0; j < Robot::nj; ++j) qm[j] = 0.5 * (limits.q_min[j] + limits.q_max[j]);
+    hm::crba<Robot>(d, qm);
+    const Eigen::MatrixXd Minv = Eigen::MatrixXd(d.M).inverse();
+    const double wn = 2.0 * 3.14159265358979 * pd_hz;
+    for (int j = 0; j < Robot::nj; ++j) {
+      const double f_urdf = Robot::bodies[static_cast<std::size_t>(j)].friction;
+      e_break[j] = std::max(0.005, (5.0 - f_urdf) * Minv(j, j) / (wn * wn));
+    }
+  }
+  {
+    const int L = es.fourier.harmonics, per = hi::FourierTrajectory::freePerJoint(es.fourier);
+    Eigen::VectorXd best_x(validation.numFree());
+    Eigen::VectorXd best = Eigen::VectorXd::Constant(Robot::nj, 2.0);
+    for (int c = 0; c < val_candidates; ++c) {
+      std::mt19937 rng(1000 + seed + static_cast<unsigned>(c));
+      std::normal_distribution<double> normal(0.0, 1.0);
+      const double p = -1.0 + (c / 2) % 4;
+      Eigen::VectorXd x(validation.numFree());
+      for (int j = 0; j < Robot::nj; ++j) {
+        Eigen::VectorXd a(L - 1), b(L - 1), l(L - 1);
+        for (int i = 0; i < L - 1; ++i) {
+          l[i] = i + 2;
+          a[i] = std::pow(l[i], p) * normal(rng);
+          b[i] = std::pow(l[i], p) * normal(rng);
+        }
+        if (c % 2 == 1) {
+          // Σ a_l = 0 and Σ l b_l = 0: the rest conditions leave the first harmonic at zero.
+          a.array() -= a.mean();
+          b -= (l.dot(b) / l.squaredNorm()) * l;
+        }
+        x[j * per] = 0.5 * (limits.q_min[j] + limits.q_max[j]);
+        x.segment(j * per + 1, L - 1) = a;
+        x.segment(j * per + L, L - 1) = b;
+      }
+      hi::FourierTrajectory cand(Robot::nj, es.fourier);
+      cand.setFree(x);
+      scaleToLimits(cand, limits, val_fill);
+      const Eigen::VectorXd stuck = stuckShare(cand, e_break);
+      for (int j = 0; j < Robot::nj; ++j) {
+        if (stuck[j] < best[j]) {
+          best[j] = stuck[j];
+          best_x.segment(j * per, per) = cand.free().segment(j * per, per);
+        }
+      }
+    }
+    validation.setFree(best_x);
+  }
+  const Eigen::VectorXd stuck_val = stuckShare(validation, e_break);
+  std::printf("validation: breakaway error (rad)\n ");
+  for (int j = 0; j < Robot::nj; ++j) std::printf(" %s %.3f", joints[j].c_str(), e_break[j]);
+  std::printf("\nvalidation: estimated stuck share of the reference (within the breakaway error of a turning point)\n ");
+  for (int j = 0; j < Robot::nj; ++j) std::printf(" %s %.0f %%", joints[j].c_str(), 100 * stuck_val[j]);
+  std::printf("\n");
 
   double track_fit = 0.0, track_val = 0.0;
   Eigen::MatrixXd fit_clean, val_clean;
