@@ -260,18 +260,7 @@ int main(int argc, char** argv) {
     if (!predict_out.empty()) {
       std::ofstream p(predict_out);
       if (!p) throw std::runtime_error(predict_out + ": cannot write");
-      p << "time";
-      for (const char* s : {"tau_", "tau_id_", "tau_cad_"}) {
-        for (const std::string& j : joints) p << "," << s << j;
-      }
-      p << "\n";
-      for (Eigen::Index k = 0; k < v.q.rows(); ++k) {
-        p << v.time[k];
-        for (const Eigen::MatrixXd* m : {&v.tau, &ident, &cad}) {
-          for (int j = 0; j < Robot::nj; ++j) p << "," << (*m)(k, j);
-        }
-        p << "\n";
-      }
+      hi::writeTorquePrediction(p, v.time, joints, v.tau, ident, cad);
       std::printf("wrote %s\n", predict_out.c_str());
     }
   } catch (const std::exception& e) {

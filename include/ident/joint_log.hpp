@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <istream>
+#include <ostream>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -138,6 +139,25 @@ inline JointLog readJointLog(std::istream& in, const std::vector<std::string>& j
     }
   }
   return log;
+}
+
+// Torque prediction on a log, as CSV: time, tau_<joint>… (measured), tau_id_<joint>…
+// (identified model), tau_cad_<joint>… (CAD model); the three matrices are N × n.
+inline void writeTorquePrediction(std::ostream& out, const Eigen::VectorXd& time,
+                                  const std::vector<std::string>& joints, const Eigen::MatrixXd& measured,
+                                  const Eigen::MatrixXd& identified, const Eigen::MatrixXd& cad) {
+  out << "time";
+  for (const char* s : {"tau_", "tau_id_", "tau_cad_"}) {
+    for (const std::string& j : joints) out << "," << s << j;
+  }
+  out << "\n";
+  for (Eigen::Index k = 0; k < time.size(); ++k) {
+    out << time[k];
+    for (const Eigen::MatrixXd* m : {&measured, &identified, &cad}) {
+      for (Eigen::Index j = 0; j < m->cols(); ++j) out << "," << (*m)(k, j);
+    }
+    out << "\n";
+  }
 }
 
 }  // namespace hqp::ident

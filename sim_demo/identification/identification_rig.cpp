@@ -422,18 +422,7 @@ int main(int argc, char** argv) {
               target_met, Robot::nj);
   {
     std::ofstream p(out_dir + "/rig_validation_torques.csv");
-    p << "time";
-    for (const char* s : {"tau_", "tau_id_", "tau_cad_"}) {
-      for (const std::string& j : joints) p << "," << s << j;
-    }
-    p << "\n";
-    for (Eigen::Index k = 0; k < v.q.rows(); ++k) {
-      p << v.time[k];
-      for (const Eigen::MatrixXd* m : {&v.tau, &ident, &cadp}) {
-        for (int j = 0; j < Robot::nj; ++j) p << "," << (*m)(k, j);
-      }
-      p << "\n";
-    }
+    hi::writeTorquePrediction(p, v.time, joints, v.tau, ident, cadp);
   }
   std::printf("%s: friction recovered (F_c within 0.25 N m, F_v within 0.5 N m s/rad), identified "
               "model better than CAD and < 1 N m RMS while moving, on %s joint\n",
