@@ -10,15 +10,13 @@
 #include <string>
 #include <vector>
 
+#include "support/walker3_controller.hpp"
 #include "support/walker3_standing.hpp"
-#include "tasks/controller.hpp"
-#include "tasks/controller_config_yaml.hpp"
 
 namespace {
 
 using Robot = walker3::Robot;
-using Layout = hqp::tasks::ContactLayout<Robot, 2, 6>;
-using Controller = hqp::tasks::Controller<Layout>;
+using Controller = hqp::testing::Walker3Controller;
 using Sensors = Controller::Sensors;
 using hqp::tasks::Stage;
 
@@ -56,12 +54,7 @@ void BM_Tick(benchmark::State& state) {
   const auto solver = state.range(0) == 0 ? Controller::Config::Solver::Hqp
                                           : Controller::Config::Solver::Wqp;
   const auto s = hqp::testing::walker3Standing();
-  auto cfg = hqp::tasks::loadControllerConfig<Robot>(HQP_SOURCE_DIR "/robots/walker3/controller.yaml");
-  cfg.solver = solver;
-  cfg.planner.com_height = s.com_height;
-  auto ctrl = std::make_unique<Controller>(
-      cfg, std::array<int, 2>{Robot::Frames::l_sole, Robot::Frames::r_sole},
-      std::array<int, 2>{Robot::Frames::l_ft_sensor, Robot::Frames::r_ft_sensor}, Robot::Frames::imu);
+  auto ctrl = hqp::testing::makeWalker3Controller(hqp::testing::walker3Config(solver, s.com_height));
   const auto inputs = makeInputs(s, 1000);
   Controller::Command cmd;
   constexpr int kStages = static_cast<int>(Stage::Count);

@@ -12,9 +12,8 @@
 #include <new>
 
 #include "model/rnea.hpp"
+#include "support/walker3_controller.hpp"
 #include "support/walker3_standing.hpp"
-#include "tasks/controller.hpp"
-#include "tasks/controller_config_yaml.hpp"
 #include "support/allocation_counter.hpp"
 
 using hqp::testing::g_counting;
@@ -24,24 +23,13 @@ namespace {
 
 using Robot = walker3::Robot;
 using Layout = hqp::tasks::ContactLayout<Robot, 2, 6>;
-using Controller = hqp::tasks::Controller<Layout>;
+using Controller = hqp::testing::Walker3Controller;
+using hqp::testing::makeWalker3Controller;
+using hqp::testing::walker3Config;
 using hqp::tasks::ControllerMode;
 using hqp::tasks::SafeModeReason;
 
 constexpr double kG = 9.81;
-
-Controller::Config walker3Config(Controller::Config::Solver solver, double com_height) {
-  auto cfg = hqp::tasks::loadControllerConfig<Robot>(HQP_SOURCE_DIR "/robots/walker3/controller.yaml");
-  cfg.solver = solver;
-  cfg.planner.com_height = com_height;  // C of Sec. III-A for this pose
-  return cfg;
-}
-
-std::unique_ptr<Controller> makeController(const Controller::Config& cfg) {
-  return std::make_unique<Controller>(
-      cfg, std::array<int, 2>{Robot::Frames::l_sole, Robot::Frames::r_sole},
-      std::array<int, 2>{Robot::Frames::l_ft_sensor, Robot::Frames::r_ft_sensor}, Robot::Frames::imu);
-}
 
 // τ that holds the robot at rest with m g / 2 straight up at each sole centre:
 // S_a (G − Σ_c J_cᵀ F_c), from RNEA (q̈ = 0, v = 0) and the model's sole Jacobians.
@@ -67,7 +55,7 @@ TEST_P(ControllerStanding, TorquesAreGravityCompensationAndZmpAtSoleCentre) {
   const double half = 0.5 * Robot::total_mass * kG;
   const auto sensors = hqp::testing::walker3RestingSensors(
       s, {half, half}, {Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()});
-  auto ctrl = makeController(walker3Config(GetParam(), s.com_height));
+  auto ctrl = makeWalker3Controller(walker3Config(GetParam(), s.com_height));
   Controller::Command cmd;
   const auto tau_expected = gravityCompensation(s);
   for (int k = 0; k < 3; ++k) ctrl->tick(sensors, cmd);
@@ -115,7 +103,7 @@ TEST(ControllerSafeMode, NanSensorLatchesSafeModeWithFiniteCurrents) {
   const double half = 0.5 * Robot::total_mass * kG;
   const auto good = hqp::testing::walker3RestingSensors(
       s, {half, half}, {Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()});
-  auto ctrl = makeController(walker3Config(Controller::Config::Solver::Hqp, s.com_height));
+  auto ctrl = makeWalker3Controller(walker3Config(Controller::Config::Solver::Hqp, s.com_height));
   Controller::Command cmd;
   ctrl->tick(good, cmd);
   ASSERT_EQ(ctrl->diagnostics().mode, ControllerMode::Balance);
@@ -156,7 +144,7 @@ TEST(ControllerSafeMode, SafeModeDampsJointMotion) {
   const double half = 0.5 * Robot::total_mass * kG;
   auto sensors = hqp::testing::walker3RestingSensors(
       s, {half, half}, {Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()});
-  auto ctrl = makeController(walker3Config(Controller::Config::Solver::Hqp, s.com_height));
+  auto ctrl = makeWalker3Controller(walker3Config(Controller::Config::Solver::Hqp, s.com_height));
   Controller::Command cmd;
   ctrl->tick(sensors, cmd);
   const Eigen::Matrix<double, 12, 1> tau_good = cmd.torque;
@@ -180,7 +168,7 @@ TEST(ControllerSafeMode, FallDetectedFromTorsoTilt) {
   const double half = 0.5 * Robot::total_mass * kG;
   auto sensors = hqp::testing::walker3RestingSensors(
       s, {half, half}, {Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()});
-  auto ctrl = makeController(walker3Config(Controller::Config::Solver::Hqp, s.com_height));
+  auto ctrl = makeWalker3Controller(walker3Config(Controller::Config::Solver::Hqp, s.com_height));
   Controller::Command cmd;
   ctrl->tick(sensors, cmd);
   ASSERT_EQ(ctrl->diagnostics().mode, ControllerMode::Balance);
@@ -197,7 +185,7 @@ TEST(ControllerNoAlloc, TickDoesNotAllocate) {
   const auto s = hqp::testing::walker3Standing();
   const double half = 0.5 * Robot::total_mass * kG;
   for (auto solver : {Controller::Config::Solver::Hqp, Controller::Config::Solver::Wqp}) {
-    auto ctrl = makeController(walker3Config(solver, s.com_height));
+    auto ctrl = makeWalker3Controller(walker3Config(solver, s.com_height));
     Controller::Command cmd;
     // Uneven loads and off-centre CoPs, so that constraints become active and warm starts change.
     std::array<hqp::tasks::SensorData<12, 2>, 4> inputs = {
