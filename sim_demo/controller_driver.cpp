@@ -1,6 +1,8 @@
 // The balance controller (include/tasks/controller.hpp) as the simulation's driver. The only
 // translation unit of sim_demo that instantiates the hierarchy (it is expensive to compile).
+#include <algorithm>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -43,6 +45,19 @@ class BalanceDriver final : public Driver {
            "_zmp_opt_y";
     }
     return h + ",com_err_x,com_err_y,com_err_z,torso_err_x,torso_err_y,torso_err_z,current_saturated";
+  }
+  bool solverStatus(SolverStatus& st) const override {
+    const auto& d = controller_->diagnostics();
+    st.num_levels = std::min<int>(BalanceController::num_levels, kMaxLevels);
+    for (int l = 0; l < st.num_levels; ++l) {
+      st.level_status[l] = static_cast<int>(d.levels[l].status);
+      st.level_residual[l] = d.levels[l].residual;
+    }
+    for (int c = 0; c < kContacts; ++c) {
+      st.zmp_optimized[c] = d.in_contact[c] ? d.zmp_optimized[c]
+                                            : Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+    }
+    return true;
   }
   void logRow(std::FILE* f) const override {
     const auto& d = controller_->diagnostics();

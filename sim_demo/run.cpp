@@ -45,7 +45,7 @@ class CsvLog {
       for (const char* c : {"fx", "fy", "fz", "mx", "my", "mz"}) std::fprintf(f_, ",%s_ft_%s", foot, c);
     }
     std::fprintf(f_, ",l_cop_x,l_cop_y,r_cop_x,r_cop_y,torso_pitch,torso_roll,torso_z,com_x,com_y,com_z,"
-                     "push_fx,push_fy,push_fz,ball_px,ball_py,ball_pz,tick_us,safe_mode%s\n", driver_.logHeader().c_str());
+                     "l_foot_pitch,l_foot_roll,r_foot_pitch,r_foot_roll,push_fx,push_fy,push_fz,ball_px,ball_py,ball_pz,tick_us,safe_mode%s\n", driver_.logHeader().c_str());
   }
   ~CsvLog() { std::fclose(f_); }
   void row(const Simulation& sim, const Sensors& s, const Eigen::Vector3d& push, double tick_us, bool safe) {
@@ -62,9 +62,11 @@ class CsvLog {
     }
     const Eigen::Vector3d com = sim.centerOfMass();
     const Eigen::Vector3d ball = sim.ballMomentum();
-    std::fprintf(f_, ",%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.2f,%.2f,%.2f,%.4f,%.4f,%.4f,%.2f,%d", sim.torsoPitch(),
-                 sim.torsoRoll(), sim.torsoHeight(), com.x(), com.y(), com.z(), push.x(), push.y(), push.z(), ball.x(),
-                 ball.y(), ball.z(), tick_us, safe ? 1 : 0);
+    std::fprintf(f_, ",%.6f,%.6f,%.6f,%.6f,%.6f,%.6f", sim.torsoPitch(), sim.torsoRoll(), sim.torsoHeight(), com.x(),
+                 com.y(), com.z());
+    for (int c = 0; c < kContacts; ++c) std::fprintf(f_, ",%.6f,%.6f", sim.footPitch(c), sim.footRoll(c));
+    std::fprintf(f_, ",%.2f,%.2f,%.2f,%.4f,%.4f,%.4f,%.2f,%d", push.x(), push.y(), push.z(), ball.x(), ball.y(), ball.z(),
+                 tick_us, safe ? 1 : 0);
     driver_.logRow(f_);
     std::fputc('\n', f_);
   }
@@ -110,7 +112,17 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
     r.cop_min[c].setConstant(std::numeric_limits<double>::infinity());
     r.cop_max[c].setConstant(-std::numeric_limits<double>::infinity());
   }
-  const double com_x0 = sim.centerOfMass().x();
+  const Eigen::Vector3d com0 = sim.centerOfMass();
+  std::array<double, kContacts> foot_pitch0{}, foot_roll0{}, zmp_sq_sum{};
+  std::array<long, kContacts> zmp_tracked{};
+  for (int c = 0; c < kContacts; ++c) {
+    foot_pitch0[c] = sim.footPitch(c);
+    foot_roll0[c] = sim.footRoll(c);
+    r.zmp_margin[c] = std::numeric_limits<double>::infinity();
+  }
+  SolverStatus solver;
+  double lowest_error_sum = 0.0;
+  long solver_ticks = 0;
   // Delivered ball impulse: momentum at launch (straight flight) minus momentum when the ball
   // leaves the robot. 0: idle, 1: flying, 2: touching the robot.
   int ball_state = 0;
@@ -144,11 +156,36 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
       video_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - v0).count();
       next_frame += 1.0 / o.video_fps;
     }
+    const bool has_solver = driver.solverStatus(solver);
+    if (has_solver) {
+      r.num_levels = std::min(solver.num_levels, kMaxLevels);
+      for (int l = 0; l < r.num_levels; ++l) {
+        const int st = solver.level_status[l];
+        if (st >= 0 && st < 4) ++r.level_status_counts[l][st];
+      }
+      if (r.num_levels > 0) {
+        const double e = solver.level_residual[r.num_levels - 1];
+        r.lowest_level_error_max = std::max(r.lowest_level_error_max, e);
+        lowest_error_sum += e;
+        ++solver_ticks;
+      }
+    }
     for (int c = 0; c < kContacts; ++c) {
       const Eigen::Vector2d cop = sim.copInSole(c, s.ft[c]);
       if (!cop.allFinite()) continue;
       r.cop_min[c] = r.cop_min[c].cwiseMin(cop);
       r.cop_max[c] = r.cop_max[c].cwiseMax(cop);
+      if (!(sim.wrenchInSole(c, s.ft[c])[2] >= o.zmp_min_fz)) continue;  // unloaded: no ZMP to check
+      const auto& rect = sim.soleRectangle(c);
+      const double margin = std::min({cop.x() - rect[0].x(), rect[1].x() - cop.x(), cop.y() - rect[0].y(),
+                                      rect[1].y() - cop.y()});
+      r.zmp_margin[c] = std::min(r.zmp_margin[c], margin);
+      if (margin < o.zmp_edge) r.zmp_edge_time[c] += sim.controlDt();
+      if (margin < -o.zmp_tolerance) r.zmp_inside = false;
+      if (has_solver && solver.zmp_optimized[c].allFinite()) {
+        zmp_sq_sum[c] += (cop - solver.zmp_optimized[c]).squaredNorm();
+        ++zmp_tracked[c];
+      }
     }
     sim.step();
     if (ball_state > 0) {
@@ -161,9 +198,15 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
     }
 
     if (sim.feetTouch()) ++r.feet_touch_ticks;
-    const double com_dx = sim.centerOfMass().x() - com_x0;
-    r.com_x_min = std::min(r.com_x_min, com_dx);
-    r.com_x_max = std::max(r.com_x_max, com_dx);
+    const Eigen::Vector3d com_d = sim.centerOfMass() - com0;
+    r.com_x_min = std::min(r.com_x_min, com_d.x());
+    r.com_x_max = std::max(r.com_x_max, com_d.x());
+    r.com_y_min = std::min(r.com_y_min, com_d.y());
+    r.com_y_max = std::max(r.com_y_max, com_d.y());
+    for (int c = 0; c < kContacts; ++c) {
+      r.max_abs_foot_pitch[c] = std::max(r.max_abs_foot_pitch[c], std::abs(sim.footPitch(c) - foot_pitch0[c]));
+      r.max_abs_foot_roll[c] = std::max(r.max_abs_foot_roll[c], std::abs(sim.footRoll(c) - foot_roll0[c]));
+    }
     const double pitch = sim.torsoPitch(), roll = sim.torsoRoll(), z = sim.torsoHeight();
     r.max_abs_pitch = std::max(r.max_abs_pitch, std::abs(pitch));
     r.max_abs_roll = std::max(r.max_abs_roll, std::abs(roll));
@@ -187,6 +230,13 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
     }
   }
   r.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  for (int c = 0; c < kContacts; ++c) {
+    if (!std::isfinite(r.zmp_margin[c])) r.zmp_margin[c] = std::numeric_limits<double>::quiet_NaN();  // never loaded
+    r.zmp_tracking_rms[c] = zmp_tracked[c] > 0 ? std::sqrt(zmp_sq_sum[c] / zmp_tracked[c])
+                                               : std::numeric_limits<double>::quiet_NaN();
+  }
+  if (solver_ticks > 0) r.lowest_level_error_mean = lowest_error_sum / solver_ticks;
+  r.passed = !r.fell && r.safe_mode_ticks == 0 && r.zmp_inside;
   // The real-time factor of the loop itself, without video rendering (which is offline work).
   r.real_time_factor = r.duration / std::max(1e-9, r.wall_time - video_s);
   if (!tick_us.empty()) {

@@ -14,6 +14,16 @@
 
 namespace hqp::sim {
 
+constexpr int kMaxLevels = 8;
+
+// One tick of a QP-based driver, as the run's metrics need it.
+struct SolverStatus {
+  int num_levels = 0;
+  std::array<int, kMaxLevels> level_status{};        // hqp::QpStatus as int
+  std::array<double, kMaxLevels> level_residual{};   // ||A x - b||^2 of each level's tasks
+  std::array<Eigen::Vector2d, kContacts> zmp_optimized;  // from F*, sole frame (m)
+};
+
 // What sits between the sensors and the motors. Virtual is fine here: this is the simulator,
 // not the controller's real-time path.
 class Driver {
@@ -26,6 +36,8 @@ class Driver {
   // Extra CSV columns of this driver (diagnostics): header text starting with ',' and one row.
   virtual std::string logHeader() const { return {}; }
   virtual void logRow(std::FILE*) const {}
+  // This tick's solver outcome for the run's metrics; false for drivers without a QP.
+  virtual bool solverStatus(SolverStatus&) const { return false; }
 };
 
 // Joint PD to the standing pose from encoder data only (the stand-in before the balance
@@ -56,6 +68,12 @@ struct RunOptions {
   int video_width = 640, video_height = 480, video_fps = 30;
   double fall_height = 0.6;        // m, torso frame below this = fall
   double fall_tilt = 1.0;          // rad, torso pitch or roll beyond this = fall
+  // A measured ZMP (F/T CoP) more than this outside its sole rectangle fails the run. A real ZMP
+  // cannot leave the sole; the F/T one can, by the soft contact's penetration times the
+  // tangential/normal force ratio when a foot loads its edge (observed up to ~2 mm while tipping).
+  double zmp_tolerance = 0.003;    // m
+  double zmp_edge = 0.002;         // m, a ZMP closer than this to the edge counts as "on the edge"
+  double zmp_min_fz = 30.0;        // N, a foot is loaded (its ZMP counts) above this normal force
   bool progress = false;           // a progress line every simulated second
   std::vector<Push> pushes;
 };
@@ -77,6 +95,22 @@ struct RunSummary {
   // Measured CoP (sole frame, from the F/T data) extremes per foot while loaded (f_z >= 10 N).
   std::array<Eigen::Vector2d, kContacts> cop_min, cop_max;
   double com_x_min = 0, com_x_max = 0;  // m, CoM x excursion relative to t = 0
+  double com_y_min = 0, com_y_max = 0;  // m, CoM y excursion relative to t = 0
+  // Feet (sole plates, world pitch/roll relative to t = 0): the paper's Fig. 8(a).
+  std::array<double, kContacts> max_abs_foot_pitch{}, max_abs_foot_roll{};
+  // Measured ZMP against the sole rectangle (the scene's sole plate): smallest distance to an
+  // edge over the loaded ticks (negative: outside), time on the edge, and whether it stayed inside.
+  std::array<double, kContacts> zmp_margin{};
+  std::array<double, kContacts> zmp_edge_time{};          // s
+  bool zmp_inside = true;
+  // Measured minus optimized ZMP (RMS over the ticks both exist, m): torque-tracking quality.
+  std::array<double, kContacts> zmp_tracking_rms{};
+  // Solver: per level the count of ticks by status (hqp::QpStatus order), and the lowest level's
+  // task error ||A x - b||^2 (the paper's Fig. 9(b)).
+  int num_levels = 0;
+  std::array<std::array<long, 4>, kMaxLevels> level_status_counts{};
+  double lowest_level_error_max = 0, lowest_level_error_mean = 0;
+  bool passed = false;  // no fall, no safe mode, every loaded ZMP inside its sole (+ tolerance)
   std::string csv_path, video_path;
 };
 

@@ -1,15 +1,23 @@
-// hqp_sim: Walker3 in MuJoCo 2.2 with the 1 kHz sensor -> current loop (docs/simulation.md).
-//   hqp_sim --scenario stand --duration 10 --out DIR [--video] [--driver controller|pd] [--noise]
+// sim_demo: Walker3 in MuJoCo 2.2 under the balance controller, the paper's Section VI-A
+// scenarios with metrics, pass/fail, CSV logs, PNG plots and a headless MP4 (docs/scenarios.md).
+//   sim_demo --list
+//   sim_demo --scenario NAME [--scenario NAME ...] [--set key=value ...] [--config FILE.yaml]
+//            [--out DIR] [--no-video] [--no-plots] [--controller hqp|wqp]
+//   sim_demo --all
 #include <CLI/CLI.hpp>
 
-#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "push_sweep.hpp"
+#include "report.hpp"
 #include "run.hpp"
+#include "scenario.hpp"
 #include "simulation.hpp"
 
 #ifndef HQP_SIM_SCENE
@@ -21,95 +29,175 @@
 #ifndef HQP_SIM_CONTROLLER_CONFIG
 #define HQP_SIM_CONTROLLER_CONFIG ""
 #endif
+#ifndef HQP_SIM_PYTHON
+#define HQP_SIM_PYTHON "/usr/bin/python3"
+#endif
+#ifndef HQP_SIM_PLOT_SCRIPT
+#define HQP_SIM_PLOT_SCRIPT ""
+#endif
+
+namespace {
+
+namespace fs = std::filesystem;
+using hqp::sim::ScenarioParams;
+
+struct Paths {
+  std::string scene = HQP_SIM_SCENE, plant = HQP_SIM_PLANT, controller_config = HQP_SIM_CONTROLLER_CONFIG;
+  std::string python = HQP_SIM_PYTHON, plot_script = HQP_SIM_PLOT_SCRIPT;
+};
+
+std::string shellQuote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+// The paper's figures as PNG (sim_demo/plots/plot_scenario.py, matplotlib); a missing Python or
+// matplotlib costs the plots, not the run.
+std::vector<std::string> makePlots(const Paths& paths, const ScenarioParams& p, const std::string& csv,
+                                   const std::string& dir) {
+  if (paths.plot_script.empty() || !fs::exists(paths.plot_script)) return {};
+  std::string pushes;
+  for (const hqp::sim::Push& push : p.run.pushes) pushes += (pushes.empty() ? "" : ",") + std::to_string(push.time);
+  std::string cmd = shellQuote(paths.python) + " " + shellQuote(paths.plot_script) + " " + shellQuote(csv) + " --out " +
+                    shellQuote(dir) + " --title " + shellQuote(p.name + " (" + p.controller + ")");
+  if (!pushes.empty()) cmd += " --pushes " + pushes;
+  std::fflush(stdout);
+  if (std::system(cmd.c_str()) != 0) {
+    std::fprintf(stderr, "sim_demo: plotting failed (%s); the CSV is complete\n", cmd.c_str());
+    return {};
+  }
+  std::vector<std::string> files;
+  const std::string stem = fs::path(csv).stem().string();
+  for (const char* fig : {"_fig8.png", "_fig9.png", "_fig13.png"}) {
+    const fs::path f = fs::path(dir) / (stem + fig);
+    if (fs::exists(f)) files.push_back(f.string());
+  }
+  return files;
+}
+
+std::unique_ptr<hqp::sim::Driver> makeDriver(const std::string& driver_name, const Paths& paths,
+                                             const ScenarioParams& p, const hqp::sim::Simulation& sim) {
+  if (driver_name == "pd") return hqp::sim::makeJointPdDriver(sim);
+  auto d = hqp::sim::makeBalanceController(paths.controller_config, p.controller == "wqp");
+  if (!d) throw std::runtime_error("this build has no balance controller; use --driver pd");
+  return d;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Walker3 balance simulation (MuJoCo 2.2, 1 kHz sensor -> current loop)"};
-  hqp::sim::SimulationOptions sim_opt;
-  sim_opt.scene = HQP_SIM_SCENE;
-  sim_opt.plant = HQP_SIM_PLANT;
-  hqp::sim::RunOptions run;
-  run.progress = true;
-  std::string driver_name = hqp::sim::balanceControllerAvailable() ? "controller" : "pd";
-  std::string controller_config = HQP_SIM_CONTROLLER_CONFIG;
-  std::string solver = "hqp";
-  app.add_option("--scenario", run.scenario, "scenario")->check(CLI::IsMember({"stand"}))->capture_default_str();
-  app.add_option("--duration", run.duration, "simulated time (s)")->check(CLI::Range(0.001, 3600.0))->capture_default_str();
-  app.add_option("--out", run.out_dir, "output directory (CSV log, video)");
-  app.add_flag("--video", run.video, "render an MP4 headless (EGL + ffmpeg; slow)");
-  app.add_option("--driver", driver_name, "controller (balance controller) or pd (joint PD stand-in)")
+  CLI::App app{"Walker3 balance scenarios in MuJoCo 2.2 (1 kHz sensor -> current loop); docs/scenarios.md"};
+  Paths paths;
+  bool list = false, all = false, no_video = false, no_plots = false;
+  std::vector<std::string> names, sets, video_only;
+  std::string config, out = "out", controller, driver_name = "controller";
+  app.add_flag("--list", list, "list the scenarios and their parameters");
+  app.add_option("--scenario", names, "scenario to run (repeatable); see --list");
+  app.add_flag("--all", all, "run every scenario");
+  app.add_option("--set", sets, "override a parameter, key=value (repeatable; see --list)");
+  app.add_option("--config", config, "YAML file of parameter overrides (applied before --set)")->check(CLI::ExistingFile);
+  app.add_option("--out", out, "output directory")->capture_default_str();
+  app.add_flag("--no-video", no_video, "skip the MP4 videos");
+  app.add_option("--video-only", video_only, "render videos only for these scenarios (repeatable)");
+  app.add_flag("--no-plots", no_plots, "skip the PNG plots");
+  app.add_option("--controller", controller, "hqp (strict hierarchy) or wqp (weighted); same as --set controller=")
+      ->check(CLI::IsMember({"hqp", "wqp"}));
+  app.add_option("--driver", driver_name, "controller (balance controller) or pd (joint PD stand-in, no QP)")
       ->check(CLI::IsMember({"controller", "pd"}))->capture_default_str();
-  app.add_option("--controller", solver, "balance controller solver")->check(CLI::IsMember({"hqp", "wqp"}))
-      ->capture_default_str();
-  app.add_option("--controller-config", controller_config, "controller YAML")->capture_default_str();
-  app.add_option("--scene", sim_opt.scene, "scene MJCF")->capture_default_str();
-  app.add_option("--plant", sim_opt.plant, "plant parameter YAML")->capture_default_str();
-  app.add_option("--substeps", sim_opt.substeps, "physics steps per 1 ms tick")->check(CLI::Range(1, 20))
-      ->capture_default_str();
-  app.add_flag("--noise", sim_opt.noise, "add the plant file's Gaussian sensor noise");
-  app.add_option("--seed", sim_opt.seed, "noise seed")->capture_default_str();
-  std::vector<std::string> pushes;
-  bool ball = false;
-  app.add_option("--push", pushes,
-                 "impulse on the torso, TIME:IX:IY (s, N·s, world), applied over 10 ms; repeatable");
-  app.add_flag("--ball", ball, "pushes throw the scene's 5 kg ball with momentum IX:IY instead of a force");
+  app.add_option("--scene", paths.scene, "scene MJCF")->capture_default_str();
+  app.add_option("--plant", paths.plant, "plant parameter YAML")->capture_default_str();
+  app.add_option("--controller-config", paths.controller_config, "controller YAML")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
-  for (const std::string& p : pushes) {
-    hqp::sim::Push push;
-    double t = 0, ix = 0, iy = 0;
-    char tail = 0;
-    if (std::sscanf(p.c_str(), "%lf:%lf:%lf%c", &t, &ix, &iy, &tail) != 3 || t < 0) {
-      std::fprintf(stderr, "hqp_sim: --push '%s': expected TIME:IX:IY, e.g. 1.0:10:0\n", p.c_str());
-      return 2;
-    }
-    push.time = t;
-    push.impulse = Eigen::Vector3d(ix, iy, 0.0);
-    push.ball = ball;
-    run.pushes.push_back(push);
-  }
 
-  try {
-    hqp::sim::Simulation sim(sim_opt);
-    std::unique_ptr<hqp::sim::Driver> driver;
-    if (driver_name == "controller") {
-      driver = hqp::sim::makeBalanceController(controller_config, solver == "wqp");
-      if (!driver) {
-        std::fprintf(stderr, "hqp_sim: this build has no balance controller; use --driver pd\n");
-        return 2;
+  if (list) {
+    std::printf("scenarios:\n");
+    for (const std::string& n : hqp::sim::scenarioNames()) {
+      std::printf("  %-11s %s\n", n.c_str(), hqp::sim::presetScenario(n).description.c_str());
+    }
+    std::printf("\nparameters (--set key=value, or key: value in a --config YAML file):\n");
+    for (const auto& [k, h] : hqp::sim::parameterHelp()) std::printf("  %-17s %s\n", k.c_str(), h.c_str());
+    std::printf("\npreset values:\n");
+    for (const std::string& n : hqp::sim::scenarioNames()) {
+      std::printf("  %s:", n.c_str());
+      for (const auto& [k, v] : hqp::sim::parameterValues(hqp::sim::presetScenario(n))) {
+        if (k == "duration" || k == "pushes") std::printf(" %s=%s", k.c_str(), v.c_str());
       }
-    } else {
-      driver = hqp::sim::makeJointPdDriver(sim);
+      std::printf("\n");
     }
-    std::printf("hqp_sim: scenario %s, %.1f s, driver %s%s\n", run.scenario.c_str(), run.duration, driver->name(),
-                sim_opt.noise ? ", sensor noise on" : "");
-    const hqp::sim::RunSummary r = hqp::sim::runScenario(sim, *driver, run);
-    const double deg = 180.0 / M_PI;
-    std::printf("\nsummary (%s, %s)\n", run.scenario.c_str(), r.driver.c_str());
-    if (r.fell) {
-      std::printf("  result             : FELL at t = %.3f s (%s)\n", r.fall_time, r.fall_reason.c_str());
-    } else {
-      std::printf("  result             : standing after %.2f s (no fall)\n", r.duration);
-    }
-    std::printf("  max torso pitch    : %.2f deg\n", r.max_abs_pitch * deg);
-    std::printf("  max torso roll     : %.2f deg\n", r.max_abs_roll * deg);
-    std::printf("  min torso height   : %.4f m\n", r.min_torso_height);
-    std::printf("  CoM x excursion    : %+.1f .. %+.1f mm\n", r.com_x_min * 1e3, r.com_x_max * 1e3);
-    for (int c = 0; c < hqp::sim::kContacts; ++c) {
-      std::printf("  %s CoP (sole frame) : x %+.1f .. %+.1f mm, y %+.1f .. %+.1f mm\n", c == 0 ? "left " : "right",
-                  r.cop_min[c].x() * 1e3, r.cop_max[c].x() * 1e3, r.cop_min[c].y() * 1e3, r.cop_max[c].y() * 1e3);
-    }
-    std::printf("  real-time factor   : %.1f (%.2f s wall for %.2f s simulated%s)\n", r.real_time_factor, r.wall_time,
-                r.duration, r.video_path.empty() ? "" : ", video excluded");
-    std::printf("  %s time : mean %.1f us, max %.1f us, 99.9%% %.1f us\n",
-                driver_name == "controller" ? "controller" : "driver    ", r.tick_mean_us, r.tick_max_us,
-                r.tick_p999_us);
-    if (ball) std::printf("  ball impulse       : %.2f %.2f %.2f N·s delivered (ball momentum lost)\n", r.ball_impulse.x(), r.ball_impulse.y(), r.ball_impulse.z());
-    if (r.feet_touch_ticks > 0) std::printf("  feet touching      : %.3f s (the F/T CoP includes foot-on-foot forces then)\n", r.feet_touch_ticks * sim.controlDt());
-    if (r.safe_mode_ticks > 0) std::printf("  safe-mode ticks    : %ld\n", r.safe_mode_ticks);
-    if (!r.csv_path.empty()) std::printf("  log                : %s\n", r.csv_path.c_str());
-    if (!r.video_path.empty()) std::printf("  video              : %s\n", r.video_path.c_str());
-    return r.fell ? 1 : 0;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "hqp_sim: %s\n", e.what());
+    return 0;
+  }
+  if (all) names = hqp::sim::scenarioNames();
+  if (names.empty()) {
+    std::fprintf(stderr, "sim_demo: nothing to run: give --scenario NAME, --all or --list\n");
     return 2;
   }
+
+  // Resolve every scenario before running any: a typo fails at once, not after minutes.
+  std::vector<ScenarioParams> scenarios;
+  try {
+    for (const std::string& n : names) {
+      ScenarioParams p = hqp::sim::presetScenario(n);
+      if (!config.empty()) hqp::sim::applyParameterFile(p, config);
+      for (const std::string& s : sets) hqp::sim::applyAssignment(p, s);
+      if (!controller.empty()) p.controller = controller;
+      scenarios.push_back(p);
+    }
+    for (const std::string& v : video_only) hqp::sim::presetScenario(v);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "sim_demo: %s\n", e.what());
+    return 2;
+  }
+
+  std::vector<nlohmann::json> records;
+  bool all_passed = true;
+  try {
+    fs::create_directories(out);
+    for (const ScenarioParams& p : scenarios) {
+      hqp::sim::SimulationOptions so;
+      so.scene = paths.scene;
+      so.plant = paths.plant;
+      so.noise = p.noise;
+      so.seed = p.seed;
+      so.substeps = p.substeps;
+      hqp::sim::Simulation sim(so);
+      auto driver = makeDriver(driver_name, paths, p, sim);
+      const std::string dir = (fs::path(out) / (p.name + (p.controller == "hqp" ? "" : "_" + p.controller))).string();
+      fs::create_directories(dir);
+      std::printf("\n== %s: %s; %s%s ==\n", p.name.c_str(), p.description.c_str(), driver->name(),
+                  p.noise ? ", sensor noise on" : "");
+      std::fflush(stdout);
+      nlohmann::json record;
+      if (p.sweep) {
+        const auto on_trial = [](const hqp::sim::SweepDirection& d, const hqp::sim::SweepTrial& t) {
+          std::printf("  %s %6.2f N·s: %s (max pitch %.1f deg, roll %.1f deg)%s%s\n", d.direction.c_str(), t.impulse,
+                      t.run.passed ? "pass" : "FAIL", t.run.max_abs_pitch * 180 / M_PI,
+                      t.run.max_abs_roll * 180 / M_PI, t.run.fell ? ", fell: " : "", t.run.fall_reason.c_str());
+          std::fflush(stdout);
+        };
+        record = hqp::sim::sweepRecord(p, hqp::sim::runPushSweep(sim, *driver, p, on_trial));
+      } else {
+        hqp::sim::RunOptions o = hqp::sim::runOptions(p);
+        o.out_dir = dir;
+        o.progress = true;
+        o.video = !no_video && (video_only.empty() || std::find(video_only.begin(), video_only.end(), p.name) !=
+                                                          video_only.end());
+        const hqp::sim::RunSummary r = hqp::sim::runScenario(sim, *driver, o);
+        record = hqp::sim::runRecord(p, r);
+        if (!no_plots) record["files"]["plots"] = makePlots(paths, p, r.csv_path, dir);
+      }
+      hqp::sim::writeJson((fs::path(dir) / "summary.json").string(), record);
+      hqp::sim::printRecord(stdout, record);
+      all_passed = all_passed && record["passed"].get<bool>();
+      records.push_back(record);
+    }
+    const std::string table = hqp::sim::markdownTable(records);
+    hqp::sim::writeText((fs::path(out) / "summary.md").string(), "# Walker3 balance scenarios (sim_demo)\n\n" + table);
+    hqp::sim::writeJson((fs::path(out) / "summary.json").string(), records);
+    std::printf("\n%s\nsummary: %s/summary.md, %s/summary.json\n", table.c_str(), out.c_str(), out.c_str());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "sim_demo: %s\n", e.what());
+    return 2;
+  }
+  return all_passed ? 0 : 1;
 }

@@ -73,6 +73,19 @@ Simulation::Simulation(const SimulationOptions& options) : options_(options), rn
     const double* sq = m_->site_quat + 4 * site;
     R_sole_ft_[c] = Eigen::Quaterniond(sq[0], sq[1], sq[2], sq[3]).normalized().toRotationMatrix();
     p_sole_ft_[c] = Eigen::Vector3d(m_->site_pos[3 * site], m_->site_pos[3 * site + 1], m_->site_pos[3 * site + 2]);
+    // The sole plate: the one box geom of the sole body, axis-aligned with the sole frame.
+    int plate = -1;
+    for (int g = 0; g < m_->ngeom; ++g) {
+      if (m_->geom_bodyid[g] != sole_body_[c] || m_->geom_type[g] != mjGEOM_BOX) continue;
+      if (plate >= 0) throw std::runtime_error("sole body " + ft.sole + " has more than one box geom");
+      plate = g;
+    }
+    if (plate < 0) throw std::runtime_error("sole body " + ft.sole + " has no box geom (sole plate)");
+    const double* gq = m_->geom_quat + 4 * plate;
+    if (std::abs(std::abs(gq[0]) - 1.0) > 1e-9) throw std::runtime_error("sole plate of " + ft.sole + " is rotated");
+    const Eigen::Vector2d centre(m_->geom_pos[3 * plate], m_->geom_pos[3 * plate + 1]);
+    const Eigen::Vector2d half(m_->geom_size[3 * plate], m_->geom_size[3 * plate + 1]);
+    sole_rect_[c] = {centre - half, centre + half};
   }
   reset();
 }
@@ -111,7 +124,17 @@ void Simulation::launchBall(const Eigen::Vector3d& momentum, double distance) {
   if (ball_ < 0 || !(momentum.norm() > 0)) return;
   const Eigen::Vector3d v = momentum / m_->body_mass[ball_];
   const Eigen::Vector3d target(d_->xipos + 3 * torso_);
-  const Eigen::Vector3d start = target - distance * v.normalized();
+  const Eigen::Vector3d dir = v.normalized();
+  Eigen::Vector3d start = target - distance * dir;
+  // Start the ball `gap` from the robot's surface along its path, so that it hits at the push
+  // time (within gap / speed) instead of after a flight across the 0.6 m.
+  const Eigen::Vector3d far = target - 1.0 * dir;
+  int geom = -1;
+  const double hit = mj_ray(m_, d_, far.data(), dir.data(), nullptr, 0, ball_, &geom);
+  constexpr double gap = 0.01;
+  if (hit >= 0.0 && hit < 1.0) {
+    start = far + (hit - m_->geom_size[3 * m_->body_geomadr[ball_]] - gap) * dir;
+  }
   double* q = d_->qpos + ball_qadr_;
   q[0] = start.x();
   q[1] = start.y();
@@ -217,15 +240,25 @@ VectorJ Simulation::jointPositions() const {
 
 double Simulation::torsoHeight() const { return d_->xpos[3 * torso_ + 2]; }
 
-double Simulation::torsoPitch() const {
-  const double* R = d_->xmat + 9 * torso_;  // row-major R_world_torso
+namespace {
+
+// Pitch about world y and roll about world x of a body (ZYX Euler angles of R_world_body).
+double bodyPitch(const mjData* d, int body) {
+  const double* R = d->xmat + 9 * body;  // row-major
   return std::asin(std::clamp(-R[6], -1.0, 1.0));
 }
 
-double Simulation::torsoRoll() const {
-  const double* R = d_->xmat + 9 * torso_;
+double bodyRoll(const mjData* d, int body) {
+  const double* R = d->xmat + 9 * body;
   return std::atan2(R[7], R[8]);
 }
+
+}  // namespace
+
+double Simulation::torsoPitch() const { return bodyPitch(d_, torso_); }
+double Simulation::torsoRoll() const { return bodyRoll(d_, torso_); }
+double Simulation::footPitch(int c) const { return bodyPitch(d_, sole_body_[c]); }
+double Simulation::footRoll(int c) const { return bodyRoll(d_, sole_body_[c]); }
 
 Eigen::Vector3d Simulation::centerOfMass() const {
   return Eigen::Vector3d(d_->subtree_com + 3 * torso_);  // the robot is the torso's subtree

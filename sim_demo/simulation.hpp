@@ -57,9 +57,10 @@ class Simulation {
   // External force (world, N) at the torso's centre of mass until changed (pushes).
   void setTorsoForce(const Eigen::Vector3d& f);
   // The scene's 5 kg ball (body "ball"), if it has one: thrown horizontally with momentum
-  // `momentum` (N·s, world; m v) at the torso's centre of mass from `distance` m away. It flies
-  // straight (gravity cancelled by an applied force) until it first touches something; then it
-  // is an ordinary body. The impulse the robot receives is what the ball loses: ballMomentum()
+  // `momentum` (N·s, world; m v) at the torso's centre of mass, starting 1 cm before the robot's
+  // surface on that line (so it hits at the push time; `distance` m from the torso's CoM if the
+  // line misses the robot). It flies straight (gravity cancelled by an applied force) until it
+  // first touches something; then it is an ordinary body. The impulse the robot receives is what the ball loses: ballMomentum()
   // before minus after.
   bool hasBall() const { return ball_ >= 0; }
   void launchBall(const Eigen::Vector3d& momentum, double distance = 0.6);
@@ -86,6 +87,11 @@ class Simulation {
   double torsoPitch() const;                // rad, about world y (+: leaning forward)
   double torsoRoll() const;                 // rad, about world x
   Eigen::Vector3d centerOfMass() const;     // m, world
+  double footPitch(int c) const;            // rad, sole plate about world y
+  double footRoll(int c) const;             // rad, sole plate about world x
+  // The sole plate's rectangle in the sole frame (x_min, y_min), (x_max, y_max), from the
+  // scene's collision box: what the measured ZMP is checked against.
+  const std::array<Eigen::Vector2d, 2>& soleRectangle(int c) const { return sole_rect_[c]; }
   bool nonFootContact() const;              // a robot geom other than a sole plate is in contact
   bool feetTouch() const;                   // the two sole plates touch each other (corrupts the F/T CoP)
 
@@ -110,6 +116,7 @@ class Simulation {
   std::array<int, kContacts> ft_force_{}, ft_torque_{}, sole_body_{};
   std::array<Eigen::Matrix3d, kContacts> R_sole_ft_;  // F/T frame axes in the sole frame
   std::array<Eigen::Vector3d, kContacts> p_sole_ft_;  // F/T origin in the sole frame
+  std::array<std::array<Eigen::Vector2d, 2>, kContacts> sole_rect_;
   std::mt19937 rng_;
 };
 

@@ -16,6 +16,7 @@
 #include <string>
 
 #include "run.hpp"
+#include "scenario.hpp"
 #include "simulation.hpp"
 
 namespace {
@@ -369,54 +370,77 @@ TEST_F(SimFriction, SlidesAboveBreakawayAtTheViscousSpeed) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The balance controller (if this build has it) keeps Walker3 standing for 2 s on sensor data.
-TEST(SimController, StandsTwoSecondsWithoutFalling) {
-  if (!hqp::sim::balanceControllerAvailable()) GTEST_SKIP() << "built without the balance controller";
-  Simulation sim(defaultOptions());
+// The balance controller (if this build has it) through the demo's scenario presets
+// (sim_demo/scenario.hpp): what `sim_demo --scenario NAME --set ...` runs. Each asserts the run's
+// pass criterion itself (no fall, no safe mode, every loaded foot's F/T ZMP inside its sole plate)
+// and checks the ZMP margin against the sole box read from MuJoCo's model, not the controller's YAML.
+
+hqp::sim::RunSummary runPreset(const std::string& name, const std::vector<std::string>& sets) {
+  hqp::sim::ScenarioParams p = hqp::sim::presetScenario(name);
+  for (const std::string& s : sets) hqp::sim::applyAssignment(p, s);
+  SimulationOptions so = defaultOptions();
+  so.noise = p.noise;
+  Simulation sim(so);
   auto controller = hqp::sim::makeBalanceController(
-      (std::filesystem::path(HQP_SIM_URDF).parent_path() / "controller.yaml").string(), false);
-  ASSERT_TRUE(controller);
-  hqp::sim::RunOptions o;
-  o.duration = 2.0;
-  const hqp::sim::RunSummary r = hqp::sim::runScenario(sim, *controller, o);
-  EXPECT_FALSE(r.fell) << r.fall_reason << " at " << r.fall_time;
-  EXPECT_NEAR(r.duration, 2.0, 1e-6);
-  EXPECT_EQ(r.safe_mode_ticks, 0);
-  EXPECT_LT(r.max_abs_pitch, 0.05);
-  EXPECT_LT(r.max_abs_roll, 0.05);
-  EXPECT_GT(r.min_torso_height, 0.9);
+      (std::filesystem::path(HQP_SIM_URDF).parent_path() / "controller.yaml").string(), p.controller == "wqp");
+  EXPECT_TRUE(controller);
+  if (!controller) return {};
+  return hqp::sim::runScenario(sim, *controller, hqp::sim::runOptions(p));
 }
 
-}  // namespace
+void expectPassed(const hqp::sim::RunSummary& r, double duration) {
+  EXPECT_FALSE(r.fell) << r.fall_reason << " at " << r.fall_time;
+  EXPECT_NEAR(r.duration, duration, 1e-6);
+  EXPECT_EQ(r.safe_mode_ticks, 0);
+  EXPECT_EQ(r.feet_touch_ticks, 0);
+  EXPECT_TRUE(r.zmp_inside);
+  for (int c = 0; c < kContacts; ++c) {
+    // The sole plate is 0.22 x 0.10 m (robots/walker3/README.md): the F/T ZMP stays within it.
+    EXPECT_GE(r.zmp_margin[c], -0.003) << "foot " << c;
+    EXPECT_GE(r.cop_min[c].x(), -0.113);
+    EXPECT_LE(r.cop_max[c].x(), 0.113);
+    EXPECT_GE(r.cop_min[c].y(), -0.053);
+    EXPECT_LE(r.cop_max[c].y(), 0.053);
+  }
+  EXPECT_TRUE(r.passed);
+  ASSERT_EQ(r.num_levels, 4);
+  for (int l = 0; l < r.num_levels; ++l) {
+    EXPECT_EQ(r.level_status_counts[l][0], std::lround(duration * 1000)) << "level " << l + 1 << " not always optimal";
+  }
+}
 
-namespace {
+TEST(SimController, StandsQuietlyForThreeSeconds) {
+  if (!hqp::sim::balanceControllerAvailable()) GTEST_SKIP() << "built without the balance controller";
+  const hqp::sim::RunSummary r = runPreset("stand", {"duration=3"});
+  expectPassed(r, 3.0);
+  EXPECT_LT(r.max_abs_pitch, 0.01);
+  EXPECT_LT(r.max_abs_roll, 0.01);
+  EXPECT_GT(r.min_torso_height, 0.9);
+  for (int c = 0; c < kContacts; ++c) {
+    // The start transient (the first ticks load the feet from zero torque) moves the ZMPs to
+    // -84 mm in x; afterwards they sit within 1 mm of the sole centre.
+    EXPECT_GT(r.zmp_margin[c], 0.02) << "quiet standing keeps each ZMP well inside (foot " << c << ")";
+    EXPECT_EQ(r.zmp_edge_time[c], 0.0);
+    EXPECT_LT(r.max_abs_foot_pitch[c], 0.005);
+  }
+}
 
-// A 10 N·s impulse along +X on the torso (the paper's second push, Table II): Walker3 recovers
-// with each measured CoP inside its 0.22 x 0.10 m sole (1 mm for the soft contact).
+// A 10 N·s impulse along +X on the torso (the paper's second push, Table II).
 TEST(SimController, RecoversFromA10NsPushAlongX) {
   if (!hqp::sim::balanceControllerAvailable()) GTEST_SKIP() << "built without the balance controller";
-  Simulation sim(defaultOptions());
-  auto controller = hqp::sim::makeBalanceController(
-      (std::filesystem::path(HQP_SIM_URDF).parent_path() / "controller.yaml").string(), false);
-  ASSERT_TRUE(controller);
-  hqp::sim::RunOptions o;
-  o.duration = 3.0;
-  hqp::sim::Push push;
-  push.time = 1.0;
-  push.impulse = Eigen::Vector3d(10.0, 0.0, 0.0);
-  o.pushes.push_back(push);
-  const hqp::sim::RunSummary r = hqp::sim::runScenario(sim, *controller, o);
-  EXPECT_FALSE(r.fell) << r.fall_reason << " at " << r.fall_time;
-  EXPECT_EQ(r.safe_mode_ticks, 0);
+  const hqp::sim::RunSummary r = runPreset("push_x", {"pushes=1.5:10:0", "duration=4.5"});
+  expectPassed(r, 4.5);
   EXPECT_GT(r.max_abs_pitch, 0.02) << "the push did not reach the robot";
-  EXPECT_GT(r.com_x_max, 0.01);
-  EXPECT_EQ(r.feet_touch_ticks, 0);
-  for (int c = 0; c < kContacts; ++c) {
-    EXPECT_GE(r.cop_min[c].x(), -0.111);
-    EXPECT_LE(r.cop_max[c].x(), 0.111);
-    EXPECT_GE(r.cop_min[c].y(), -0.051);
-    EXPECT_LE(r.cop_max[c].y(), 0.051);
-  }
+  EXPECT_GT(r.com_x_max, 0.005);
+}
+
+// A 10 N·s impulse along +Y (push_y's second push).
+TEST(SimController, RecoversFromA10NsPushAlongY) {
+  if (!hqp::sim::balanceControllerAvailable()) GTEST_SKIP() << "built without the balance controller";
+  const hqp::sim::RunSummary r = runPreset("push_y", {"pushes=1.5:0:10", "duration=4.5"});
+  expectPassed(r, 4.5);
+  EXPECT_GT(r.max_abs_roll, 0.02) << "the push did not reach the robot";
+  EXPECT_GT(r.com_y_max, 0.003);
 }
 
 }  // namespace
@@ -446,6 +470,43 @@ TEST(SimController, BallHitsTheTorsoAndWalker3Stands) {
   EXPECT_LE(r.ball_impulse.y(), 10.0 + 1e-6);
   EXPECT_NEAR(r.ball_impulse.x(), 0.0, 0.5);
   EXPECT_GT(r.max_abs_roll, 0.05) << "the ball did not reach the robot";
+}
+
+}  // namespace
+
+namespace {
+
+// Scenario parameters from a YAML file: list values, the file named in errors.
+TEST(SimScenario, YamlOverridesAndErrors) {
+  const std::string dir = ::testing::TempDir();
+  const std::string good = dir + "/scenario_good.yaml", bad = dir + "/scenario_bad.yaml";
+  {
+    std::ofstream f(good);
+    f << "duration: 7.5\npushes: [[1, 8, 0], [4.5, 0, -10]]\npush_method: force\nsweep_directions: [+x, -y]\n";
+    std::ofstream g(bad);
+    g << "duration: 3\npush_strength: 9\n";
+  }
+  hqp::sim::ScenarioParams p = hqp::sim::presetScenario("push_x");
+  hqp::sim::applyParameterFile(p, good);
+  EXPECT_DOUBLE_EQ(p.run.duration, 7.5);
+  ASSERT_EQ(p.run.pushes.size(), 2u);
+  EXPECT_DOUBLE_EQ(p.run.pushes[1].time, 4.5);
+  EXPECT_DOUBLE_EQ(p.run.pushes[1].impulse.y(), -10.0);
+  EXPECT_FALSE(p.ball);
+  EXPECT_EQ(p.sweep_params.directions, (std::vector<std::string>{"+x", "-y"}));
+  const hqp::sim::RunOptions o = hqp::sim::runOptions(p);
+  EXPECT_FALSE(o.pushes[0].ball);
+  try {
+    hqp::sim::applyParameterFile(p, bad);
+    ADD_FAILURE() << "unknown key accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(bad), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("push_strength"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(hqp::sim::applyAssignment(p, "duration=-1"), std::invalid_argument);
+  EXPECT_THROW(hqp::sim::applyAssignment(p, "noise=maybe"), std::invalid_argument);
+  EXPECT_THROW(hqp::sim::applyAssignment(p, "sweep_directions=+z"), std::invalid_argument);
+  EXPECT_THROW(hqp::sim::presetScenario("seesaw_q"), std::invalid_argument);
 }
 
 }  // namespace

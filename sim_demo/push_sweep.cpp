@@ -1,0 +1,72 @@
+#include "push_sweep.hpp"
+
+#include <chrono>
+#include <stdexcept>
+
+namespace hqp::sim {
+
+namespace {
+
+Eigen::Vector3d unitOf(const std::string& d) {
+  if (d == "+x") return Eigen::Vector3d::UnitX();
+  if (d == "-x") return -Eigen::Vector3d::UnitX();
+  if (d == "+y") return Eigen::Vector3d::UnitY();
+  if (d == "-y") return -Eigen::Vector3d::UnitY();
+  throw std::invalid_argument("sweep direction '" + d + "' (expected +x, -x, +y or -y)");
+}
+
+}  // namespace
+
+SweepResult runPushSweep(Simulation& sim, Driver& driver, const ScenarioParams& p,
+                         const std::function<void(const SweepDirection&, const SweepTrial&)>& on_trial) {
+  const SweepParams& sp = p.sweep_params;
+  if (!(sp.max_impulse > sp.min_impulse)) throw std::invalid_argument("push_sweep: sweep_max must exceed sweep_min");
+  const auto wall0 = std::chrono::steady_clock::now();
+  SweepResult result;
+  result.passed = true;
+  for (const std::string& dir : sp.directions) {
+    SweepDirection sd;
+    sd.direction = dir;
+    const Eigen::Vector3d u = unitOf(dir);
+    auto trial = [&](double impulse) {
+      ScenarioParams tp = p;
+      tp.run.pushes.clear();
+      Push push;
+      push.time = sp.push_time;
+      push.impulse = impulse * u;
+      tp.run.pushes.push_back(push);
+      tp.run.duration = sp.push_time + sp.observe;
+      RunOptions o = runOptions(tp);
+      o.out_dir.clear();  // trials leave no files
+      o.video = false;
+      o.progress = false;
+      SweepTrial t;
+      t.impulse = impulse;
+      t.run = runScenario(sim, driver, o);
+      sd.trials.push_back(t);
+      if (on_trial) on_trial(sd, sd.trials.back());
+      return t.run.passed;
+    };
+    double lo = sp.min_impulse, hi = sp.max_impulse;
+    if (!trial(lo)) {
+      sd.largest_passed = 0.0;
+      sd.smallest_failed = lo;
+    } else if (trial(hi)) {
+      sd.largest_passed = hi;
+      sd.smallest_failed = 0.0;
+    } else {
+      while (hi - lo > sp.resolution) {
+        const double mid = 0.5 * (lo + hi);
+        (trial(mid) ? lo : hi) = mid;
+      }
+      sd.largest_passed = lo;
+      sd.smallest_failed = hi;
+    }
+    if (sd.largest_passed < sp.required) result.passed = false;
+    result.directions.push_back(std::move(sd));
+  }
+  result.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return result;
+}
+
+}  // namespace hqp::sim

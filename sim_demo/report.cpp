@@ -1,0 +1,256 @@
+#include "report.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "hqp/qp_status.hpp"
+
+namespace hqp::sim {
+
+namespace {
+
+constexpr double kDeg = 180.0 / M_PI;
+constexpr const char* kFoot[kContacts] = {"left", "right"};
+
+// NaN/inf become null (JSON has no NaN).
+nlohmann::json num(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
+
+nlohmann::json parametersJson(const ScenarioParams& p) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& [k, v] : parameterValues(p)) j[k] = v;
+  return j;
+}
+
+std::string fmt(const char* f, double x) {
+  char b[64];
+  std::snprintf(b, sizeof(b), f, x);
+  return b;
+}
+
+std::string fmtOr(const nlohmann::json& j, const char* f, const char* missing = "–") {
+  return j.is_number() ? fmt(f, j.get<double>()) : std::string(missing);
+}
+
+}  // namespace
+
+nlohmann::json runRecord(const ScenarioParams& p, const RunSummary& r) {
+  nlohmann::json j;
+  j["scenario"] = p.name;
+  j["description"] = p.description;
+  j["controller"] = p.controller;
+  j["driver"] = r.driver;
+  j["passed"] = r.passed;
+  j["fell"] = r.fell;
+  j["fall_time"] = r.fell ? nlohmann::json(r.fall_time) : nlohmann::json(nullptr);
+  j["fall_reason"] = r.fall_reason;
+  j["duration_s"] = r.duration;
+  j["max_torso_pitch_deg"] = r.max_abs_pitch * kDeg;
+  j["max_torso_roll_deg"] = r.max_abs_roll * kDeg;
+  j["min_torso_height_m"] = r.min_torso_height;
+  j["com_x_min_mm"] = r.com_x_min * 1e3;
+  j["com_x_max_mm"] = r.com_x_max * 1e3;
+  j["com_y_min_mm"] = r.com_y_min * 1e3;
+  j["com_y_max_mm"] = r.com_y_max * 1e3;
+  j["max_foot_pitch_deg"] = r.max_abs_foot_pitch[1] * kDeg;  // the right foot, as in the paper's Fig. 8(a)
+  j["zmp_inside"] = r.zmp_inside;
+  double margin = std::numeric_limits<double>::infinity();
+  for (int c = 0; c < kContacts; ++c) {
+    if (std::isfinite(r.zmp_margin[c])) margin = std::min(margin, r.zmp_margin[c]);
+  }
+  j["zmp_margin_mm"] = num(margin * 1e3);
+  nlohmann::json feet = nlohmann::json::array();
+  for (int c = 0; c < kContacts; ++c) {
+    feet.push_back({{"foot", kFoot[c]},
+                    {"max_pitch_deg", r.max_abs_foot_pitch[c] * kDeg},
+                    {"max_roll_deg", r.max_abs_foot_roll[c] * kDeg},
+                    {"zmp_margin_mm", num(r.zmp_margin[c] * 1e3)},
+                    {"zmp_edge_time_s", r.zmp_edge_time[c]},
+                    {"zmp_x_range_mm", {num(r.cop_min[c].x() * 1e3), num(r.cop_max[c].x() * 1e3)}},
+                    {"zmp_y_range_mm", {num(r.cop_min[c].y() * 1e3), num(r.cop_max[c].y() * 1e3)}},
+                    {"zmp_tracking_rms_mm", num(r.zmp_tracking_rms[c] * 1e3)}});
+  }
+  j["feet"] = feet;
+  j["lowest_level_error_max"] = r.lowest_level_error_max;
+  j["lowest_level_error_mean"] = r.lowest_level_error_mean;
+  nlohmann::json levels = nlohmann::json::array();
+  for (int l = 0; l < r.num_levels; ++l) {
+    nlohmann::json c;
+    for (int s = 0; s < 4; ++s) c[toString(static_cast<QpStatus>(s))] = r.level_status_counts[l][s];
+    levels.push_back(c);
+  }
+  j["level_status_counts"] = levels;
+  j["safe_mode_ticks"] = r.safe_mode_ticks;
+  j["feet_touch_s"] = r.feet_touch_ticks * 1e-3;
+  j["tick_mean_us"] = r.tick_mean_us;
+  j["tick_max_us"] = r.tick_max_us;
+  j["tick_p999_us"] = r.tick_p999_us;
+  j["real_time_factor"] = r.real_time_factor;
+  j["wall_time_s"] = r.wall_time;
+  nlohmann::json pushes = nlohmann::json::array();
+  for (const Push& push : runOptions(p).pushes) {
+    pushes.push_back({{"time", push.time},
+                      {"impulse", {push.impulse.x(), push.impulse.y(), push.impulse.z()}},
+                      {"method", push.ball ? "ball" : "force"}});
+  }
+  j["pushes"] = pushes;
+  j["ball_impulse_delivered"] = {r.ball_impulse.x(), r.ball_impulse.y(), r.ball_impulse.z()};
+  j["parameters"] = parametersJson(p);
+  j["files"] = {{"csv", r.csv_path}, {"video", r.video_path}, {"plots", nlohmann::json::array()}};
+  return j;
+}
+
+nlohmann::json sweepRecord(const ScenarioParams& p, const SweepResult& s) {
+  nlohmann::json j;
+  j["scenario"] = p.name;
+  j["description"] = p.description;
+  j["controller"] = p.controller;
+  j["passed"] = s.passed;
+  j["required_impulse"] = p.sweep_params.required;
+  j["wall_time_s"] = s.wall_time;
+  nlohmann::json dirs = nlohmann::json::array();
+  double tick_max = 0, tick_p999 = 0;
+  for (const SweepDirection& d : s.directions) {
+    nlohmann::json trials = nlohmann::json::array();
+    for (const SweepTrial& t : d.trials) {
+      trials.push_back({{"impulse", t.impulse},
+                        {"passed", t.run.passed},
+                        {"fall_reason", t.run.fall_reason},
+                        {"max_torso_pitch_deg", t.run.max_abs_pitch * kDeg},
+                        {"max_torso_roll_deg", t.run.max_abs_roll * kDeg},
+                        {"ball_impulse_delivered",
+                         {t.run.ball_impulse.x(), t.run.ball_impulse.y(), t.run.ball_impulse.z()}}});
+      tick_max = std::max(tick_max, t.run.tick_max_us);
+      tick_p999 = std::max(tick_p999, t.run.tick_p999_us);
+    }
+    dirs.push_back({{"direction", d.direction},
+                    {"largest_passed", d.largest_passed},
+                    {"smallest_failed", num(d.smallest_failed > 0 ? d.smallest_failed : NAN)},
+                    {"trials", trials}});
+  }
+  j["directions"] = dirs;
+  j["tick_max_us"] = tick_max;
+  j["tick_p999_us_worst_trial"] = tick_p999;
+  j["parameters"] = parametersJson(p);
+  return j;
+}
+
+void printRecord(std::FILE* out, const nlohmann::json& j) {
+  const std::string name = j.value("scenario", "?");
+  std::fprintf(out, "\n== %s (%s): %s ==\n", name.c_str(), j.value("controller", "").c_str(),
+               j.value("passed", false) ? "PASS" : "FAIL");
+  if (j.contains("directions")) {
+    for (const auto& d : j["directions"]) {
+      std::fprintf(out, "  largest impulse survived along %s : %s N·s (next failure at %s N·s, %zu trials)\n",
+                   d["direction"].get<std::string>().c_str(), fmt("%.2f", d["largest_passed"].get<double>()).c_str(),
+                   fmtOr(d["smallest_failed"], "%.2f", "none up to the bracket end").c_str(), d["trials"].size());
+    }
+    std::fprintf(out, "  required (paper's largest push)   : %.1f N·s\n", j["required_impulse"].get<double>());
+    std::fprintf(out, "  wall time                         : %.1f s\n", j["wall_time_s"].get<double>());
+    return;
+  }
+  if (j["fell"].get<bool>()) {
+    std::fprintf(out, "  result             : FELL at t = %.3f s (%s)\n", j["fall_time"].get<double>(),
+                 j["fall_reason"].get<std::string>().c_str());
+  } else {
+    std::fprintf(out, "  result             : standing after %.2f s (no fall)\n", j["duration_s"].get<double>());
+  }
+  std::fprintf(out, "  max torso pitch    : %.2f deg (paper, push_x: 25.7)\n", j["max_torso_pitch_deg"].get<double>());
+  std::fprintf(out, "  max torso roll     : %.2f deg\n", j["max_torso_roll_deg"].get<double>());
+  std::fprintf(out, "  CoM x excursion    : %+.1f .. %+.1f mm (paper, push_x: -29 .. +56)\n",
+               j["com_x_min_mm"].get<double>(), j["com_x_max_mm"].get<double>());
+  std::fprintf(out, "  CoM y excursion    : %+.1f .. %+.1f mm\n", j["com_y_min_mm"].get<double>(),
+               j["com_y_max_mm"].get<double>());
+  for (const auto& f : j["feet"]) {
+    std::fprintf(out, "  %-5s foot         : pitch %.2f deg, roll %.2f deg; ZMP x %s .. %s mm, y %s .. %s mm, margin %s mm, "
+                      "%.3f s on the edge, measured-optimized RMS %s mm\n",
+                 f["foot"].get<std::string>().c_str(), f["max_pitch_deg"].get<double>(), f["max_roll_deg"].get<double>(),
+                 fmtOr(f["zmp_x_range_mm"][0], "%+.1f").c_str(), fmtOr(f["zmp_x_range_mm"][1], "%+.1f").c_str(),
+                 fmtOr(f["zmp_y_range_mm"][0], "%+.1f").c_str(), fmtOr(f["zmp_y_range_mm"][1], "%+.1f").c_str(),
+                 fmtOr(f["zmp_margin_mm"], "%.1f").c_str(), f["zmp_edge_time_s"].get<double>(),
+                 fmtOr(f["zmp_tracking_rms_mm"], "%.1f").c_str());
+  }
+  std::fprintf(out, "  ZMPs inside soles  : %s\n", j["zmp_inside"].get<bool>() ? "yes" : "NO");
+  if (!j["level_status_counts"].empty()) {
+    std::fprintf(out, "  QP status per level:");
+    int l = 1;
+    for (const auto& c : j["level_status_counts"]) {
+      std::fprintf(out, " L%d %ld opt", l++, c["Optimal"].get<long>());
+      const long bad = c["Infeasible"].get<long>() + c["IterationLimit"].get<long>() + c["NumericalFailure"].get<long>();
+      if (bad > 0) {
+        std::fprintf(out, " (%ld infeasible, %ld iteration limit, %ld numerical)", c["Infeasible"].get<long>(),
+                     c["IterationLimit"].get<long>(), c["NumericalFailure"].get<long>());
+      }
+      std::fprintf(out, ";");
+    }
+    std::fprintf(out, "\n  lowest-level error : max %.3g, mean %.3g (||A x - b||^2)\n",
+                 j["lowest_level_error_max"].get<double>(), j["lowest_level_error_mean"].get<double>());
+  }
+  std::fprintf(out, "  controller time    : mean %.1f us, max %.1f us, 99.9%% %.1f us (budget 1000 us)\n",
+               j["tick_mean_us"].get<double>(), j["tick_max_us"].get<double>(), j["tick_p999_us"].get<double>());
+  std::fprintf(out, "  real-time factor   : %.1f (%.1f s wall)\n", j["real_time_factor"].get<double>(),
+               j["wall_time_s"].get<double>());
+  const auto& b = j["ball_impulse_delivered"];
+  if (b[0].get<double>() != 0 || b[1].get<double>() != 0 || b[2].get<double>() != 0) {
+    std::fprintf(out, "  ball impulse       : %.2f %.2f %.2f N·s delivered in all (momentum the ball lost)\n",
+                 b[0].get<double>(), b[1].get<double>(), b[2].get<double>());
+  }
+  if (j["safe_mode_ticks"].get<long>() > 0) std::fprintf(out, "  safe-mode ticks    : %ld\n", j["safe_mode_ticks"].get<long>());
+  if (j["feet_touch_s"].get<double>() > 0) std::fprintf(out, "  feet touching      : %.3f s\n", j["feet_touch_s"].get<double>());
+  for (const char* k : {"csv", "video"}) {
+    const std::string f = j["files"][k].get<std::string>();
+    if (!f.empty()) std::fprintf(out, "  %-18s : %s\n", k, f.c_str());
+  }
+  for (const auto& f : j["files"]["plots"]) std::fprintf(out, "  plot               : %s\n", f.get<std::string>().c_str());
+}
+
+std::string markdownTable(const std::vector<nlohmann::json>& records) {
+  std::ostringstream s;
+  s << "| scenario | controller | result | max torso pitch (°) | max torso roll (°) | CoM x (mm) | "
+       "max right-foot pitch (°) | min ZMP margin (mm) | lowest-level error max | tick mean / p99.9 / max (µs) | RTF |\n"
+    << "|---|---|---|---|---|---|---|---|---|---|---|\n";
+  bool push_x = false;
+  for (const auto& j : records) {
+    if (j.contains("directions")) continue;
+    push_x = push_x || j["scenario"] == "push_x";
+    std::string result = j["passed"].get<bool>() ? "PASS" : "FAIL";
+    if (j["fell"].get<bool>()) result += fmt(" (fell at %.2f s: ", j["fall_time"].get<double>()) + j["fall_reason"].get<std::string>() + ")";
+    else if (!j["zmp_inside"].get<bool>()) result += " (ZMP left a sole)";
+    else if (j["safe_mode_ticks"].get<long>() > 0) result += " (safe mode)";
+    s << "| " << j["scenario"].get<std::string>() << " | " << j["controller"].get<std::string>() << " | " << result
+      << " | " << fmt("%.1f", j["max_torso_pitch_deg"].get<double>()) << " | "
+      << fmt("%.1f", j["max_torso_roll_deg"].get<double>()) << " | " << fmt("%+.0f", j["com_x_min_mm"].get<double>())
+      << " … " << fmt("%+.0f", j["com_x_max_mm"].get<double>()) << " | "
+      << fmt("%.2f", j["max_foot_pitch_deg"].get<double>()) << " | " << fmtOr(j["zmp_margin_mm"], "%.1f") << " | "
+      << fmt("%.3g", j["lowest_level_error_max"].get<double>()) << " | " << fmt("%.0f", j["tick_mean_us"].get<double>())
+      << " / " << fmt("%.0f", j["tick_p999_us"].get<double>()) << " / " << fmt("%.0f", j["tick_max_us"].get<double>())
+      << " | " << fmt("%.1f", j["real_time_factor"].get<double>()) << " |\n";
+  }
+  if (push_x) {
+    s << "| *paper, push_x (Table II, Fig. 8)* | HQP | survived 12 N·s | 25.7 | – | −29 … +56 | 1.5 | – | ~10³ peaks | 363 (loop mean) | – |\n";
+  }
+  for (const auto& j : records) {
+    if (!j.contains("directions")) continue;
+    s << "\n**" << j["scenario"].get<std::string>() << "** (" << j["controller"].get<std::string>()
+      << "): " << (j["passed"].get<bool>() ? "PASS" : "FAIL") << " — every direction must survive "
+      << fmt("%.1f", j["required_impulse"].get<double>()) << " N·s (the paper's largest push).\n\n"
+      << "| direction | largest impulse survived (N·s) | first failure (N·s) | trials |\n|---|---|---|---|\n";
+    for (const auto& d : j["directions"]) {
+      s << "| " << d["direction"].get<std::string>() << " | " << fmt("%.2f", d["largest_passed"].get<double>())
+        << " | " << fmtOr(d["smallest_failed"], "%.2f", "none up to the bracket end") << " | " << d["trials"].size()
+        << " |\n";
+    }
+  }
+  return s.str();
+}
+
+void writeJson(const std::string& path, const nlohmann::json& j) { writeText(path, j.dump(2) + "\n"); }
+
+void writeText(const std::string& path, const std::string& text) {
+  std::ofstream f(path);
+  f << text;
+  if (!f) throw std::runtime_error("cannot write " + path);
+}
+
+}  // namespace hqp::sim

@@ -1,0 +1,316 @@
+#include "scenario.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <sstream>
+#include <stdexcept>
+
+namespace hqp::sim {
+
+namespace {
+
+[[noreturn]] void badValue(const std::string& key, const std::string& value, const std::string& expected) {
+  throw std::invalid_argument("parameter '" + key + "': bad value '" + value + "' (expected " + expected + ")");
+}
+
+double parseDouble(const std::string& key, const std::string& v, double lo, double hi) {
+  char* end = nullptr;
+  errno = 0;
+  const double x = std::strtod(v.c_str(), &end);
+  if (v.empty() || *end != '\0' || errno != 0 || !std::isfinite(x)) badValue(key, v, "a number");
+  if (x < lo || x > hi) {
+    std::ostringstream s;
+    s << "a number in [" << lo << ", " << hi << "]";
+    badValue(key, v, s.str());
+  }
+  return x;
+}
+
+long parseInt(const std::string& key, const std::string& v, long lo, long hi) {
+  char* end = nullptr;
+  errno = 0;
+  const long x = std::strtol(v.c_str(), &end, 10);
+  if (v.empty() || *end != '\0' || errno != 0 || x < lo || x > hi) {
+    badValue(key, v, "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  }
+  return x;
+}
+
+bool parseBool(const std::string& key, const std::string& v) {
+  if (v == "true" || v == "1" || v == "yes" || v == "on") return true;
+  if (v == "false" || v == "0" || v == "no" || v == "off") return false;
+  badValue(key, v, "true or false");
+}
+
+std::vector<std::string> split(const std::string& v, char sep) {
+  std::vector<std::string> out;
+  std::string item;
+  std::istringstream in(v);
+  while (std::getline(in, item, sep)) out.push_back(item);
+  if (!v.empty() && v.back() == sep) out.emplace_back();
+  return out;
+}
+
+// "none" or "T:IX:IY[:IZ],..." (s, N·s, world).
+std::vector<Push> parsePushes(const std::string& key, const std::string& v) {
+  std::vector<Push> pushes;
+  if (v == "none" || v.empty()) return pushes;
+  const char* expected = "none or TIME:IX:IY[:IZ] items separated by commas, e.g. 2:8:0,5:10:0";
+  for (const std::string& item : split(v, ',')) {
+    const std::vector<std::string> f = split(item, ':');
+    if (f.size() != 3 && f.size() != 4) badValue(key, v, expected);
+    Push p;
+    p.time = parseDouble(key, f[0], 0.0, 3600.0);
+    for (std::size_t i = 1; i < f.size(); ++i) p.impulse[static_cast<int>(i) - 1] = parseDouble(key, f[i], -500.0, 500.0);
+    pushes.push_back(p);
+  }
+  return pushes;
+}
+
+std::string formatDouble(double x) {
+  char b[64];
+  std::snprintf(b, sizeof(b), "%.10g", x);
+  return b;
+}
+
+std::string formatPushes(const std::vector<Push>& pushes) {
+  if (pushes.empty()) return "none";
+  std::string s;
+  for (const Push& p : pushes) {
+    if (!s.empty()) s += ",";
+    s += formatDouble(p.time) + ":" + formatDouble(p.impulse.x()) + ":" + formatDouble(p.impulse.y());
+    if (p.impulse.z() != 0.0) s += ":" + formatDouble(p.impulse.z());
+  }
+  return s;
+}
+
+std::string join(const std::vector<std::string>& items) {
+  std::string s;
+  for (const std::string& i : items) s += (s.empty() ? "" : ",") + i;
+  return s;
+}
+
+struct Parameter {
+  const char* key;
+  const char* help;
+  std::function<void(ScenarioParams&, const std::string& key, const std::string& value)> set;
+  std::function<std::string(const ScenarioParams&)> get;
+};
+
+// Every parameter a scenario has (docs/scenarios.md lists them with the presets' values).
+const std::vector<Parameter>& parameters() {
+  using P = ScenarioParams;
+  using S = const std::string&;
+  static const std::vector<Parameter> table = {
+      {"duration", "simulated time, s",
+       [](P& p, S k, S v) { p.run.duration = parseDouble(k, v, 0.001, 3600.0); },
+       [](const P& p) { return formatDouble(p.run.duration); }},
+      {"pushes", "impulses on the torso: none or TIME:IX:IY[:IZ],... (s, N·s, world)",
+       [](P& p, S k, S v) { p.run.pushes = parsePushes(k, v); },
+       [](const P& p) { return formatPushes(p.run.pushes); }},
+      {"push_method", "ball (the scene's 5 kg ball thrown with that momentum) or force (10 ms force at the torso CoM)",
+       [](P& p, S k, S v) {
+         if (v != "ball" && v != "force") badValue(k, v, "ball or force");
+         p.ball = v == "ball";
+       },
+       [](const P& p) { return std::string(p.ball ? "ball" : "force"); }},
+      {"push_duration", "force pushes: duration of the constant force, s",
+       [](P& p, S k, S v) { p.push_duration = parseDouble(k, v, 0.001, 1.0); },
+       [](const P& p) { return formatDouble(p.push_duration); }},
+      {"controller", "hqp (strict hierarchy, the paper's) or wqp (weighted)",
+       [](P& p, S k, S v) {
+         if (v != "hqp" && v != "wqp") badValue(k, v, "hqp or wqp");
+         p.controller = v;
+       },
+       [](const P& p) { return p.controller; }},
+      {"noise", "sensor noise of plant.yaml on or off",
+       [](P& p, S k, S v) { p.noise = parseBool(k, v); },
+       [](const P& p) { return std::string(p.noise ? "true" : "false"); }},
+      {"seed", "noise seed",
+       [](P& p, S k, S v) { p.seed = static_cast<unsigned>(parseInt(k, v, 0, 4294967295L)); },
+       [](const P& p) { return std::to_string(p.seed); }},
+      {"substeps", "physics steps per 1 ms control tick",
+       [](P& p, S k, S v) { p.substeps = static_cast<int>(parseInt(k, v, 1, 20)); },
+       [](const P& p) { return std::to_string(p.substeps); }},
+      {"fall_height", "fall when the torso frame is below this height, m",
+       [](P& p, S k, S v) { p.run.fall_height = parseDouble(k, v, 0.0, 2.0); },
+       [](const P& p) { return formatDouble(p.run.fall_height); }},
+      {"fall_tilt", "fall when torso pitch or roll exceeds this, rad",
+       [](P& p, S k, S v) { p.run.fall_tilt = parseDouble(k, v, 0.01, 3.2); },
+       [](const P& p) { return formatDouble(p.run.fall_tilt); }},
+      {"zmp_tolerance", "a measured ZMP further than this outside its sole fails the run, m",
+       [](P& p, S k, S v) { p.run.zmp_tolerance = parseDouble(k, v, 0.0, 0.1); },
+       [](const P& p) { return formatDouble(p.run.zmp_tolerance); }},
+      {"video_width", "video width, pixels",
+       [](P& p, S k, S v) { p.run.video_width = static_cast<int>(parseInt(k, v, 64, 1920)); },
+       [](const P& p) { return std::to_string(p.run.video_width); }},
+      {"video_height", "video height, pixels",
+       [](P& p, S k, S v) { p.run.video_height = static_cast<int>(parseInt(k, v, 64, 1080)); },
+       [](const P& p) { return std::to_string(p.run.video_height); }},
+      {"video_fps", "video frame rate",
+       [](P& p, S k, S v) { p.run.video_fps = static_cast<int>(parseInt(k, v, 1, 120)); },
+       [](const P& p) { return std::to_string(p.run.video_fps); }},
+      {"sweep_directions", "push_sweep: directions among +x,-x,+y,-y",
+       [](P& p, S k, S v) {
+         std::vector<std::string> d = split(v, ',');
+         if (d.empty()) badValue(k, v, "a list of +x, -x, +y, -y");
+         for (const std::string& s : d) {
+           if (s != "+x" && s != "-x" && s != "+y" && s != "-y") badValue(k, v, "a list of +x, -x, +y, -y");
+         }
+         p.sweep_params.directions = d;
+       },
+       [](const P& p) { return join(p.sweep_params.directions); }},
+      {"sweep_min", "push_sweep: lower bracket end, N·s",
+       [](P& p, S k, S v) { p.sweep_params.min_impulse = parseDouble(k, v, 0.0, 500.0); },
+       [](const P& p) { return formatDouble(p.sweep_params.min_impulse); }},
+      {"sweep_max", "push_sweep: upper bracket end, N·s",
+       [](P& p, S k, S v) { p.sweep_params.max_impulse = parseDouble(k, v, 0.1, 500.0); },
+       [](const P& p) { return formatDouble(p.sweep_params.max_impulse); }},
+      {"sweep_resolution", "push_sweep: stop when the bracket is this narrow, N·s",
+       [](P& p, S k, S v) { p.sweep_params.resolution = parseDouble(k, v, 0.01, 100.0); },
+       [](const P& p) { return formatDouble(p.sweep_params.resolution); }},
+      {"sweep_push_time", "push_sweep: time of the push in each trial, s",
+       [](P& p, S k, S v) { p.sweep_params.push_time = parseDouble(k, v, 0.0, 60.0); },
+       [](const P& p) { return formatDouble(p.sweep_params.push_time); }},
+      {"sweep_observe", "push_sweep: simulated time after the push, s",
+       [](P& p, S k, S v) { p.sweep_params.observe = parseDouble(k, v, 0.1, 60.0); },
+       [](const P& p) { return formatDouble(p.sweep_params.observe); }},
+      {"sweep_required", "push_sweep: passes when every direction survives this impulse, N·s",
+       [](P& p, S k, S v) { p.sweep_params.required = parseDouble(k, v, 0.0, 500.0); },
+       [](const P& p) { return formatDouble(p.sweep_params.required); }},
+  };
+  return table;
+}
+
+std::vector<Push> series(double first, double spacing, const std::vector<double>& magnitudes,
+                         const Eigen::Vector3d& direction) {
+  std::vector<Push> pushes;
+  for (std::size_t i = 0; i < magnitudes.size(); ++i) {
+    Push p;
+    p.time = first + spacing * static_cast<double>(i);
+    p.impulse = magnitudes[i] * direction;
+    pushes.push_back(p);
+  }
+  return pushes;
+}
+
+}  // namespace
+
+std::vector<std::string> scenarioNames() { return {"stand", "push_x", "push_y", "push_sweep"}; }
+
+ScenarioParams presetScenario(const std::string& name) {
+  ScenarioParams p;
+  p.name = name;
+  // The first push waits 2 s: the controller settles its references during the first second.
+  constexpr double kFirst = 2.0, kSpacing = 3.0, kAfter = 3.0;
+  if (name == "stand") {
+    p.description = "10 s of quiet standing";
+    p.run.duration = 10.0;
+  } else if (name == "push_x") {
+    p.description = "eight impulses along +X at the torso, 3 s apart (Table II: 8, 10, 11, 12 x5 N·s)";
+    p.run.pushes = series(kFirst, kSpacing, {8, 10, 11, 12, 12, 12, 12, 12}, Eigen::Vector3d::UnitX());
+    p.run.duration = p.run.pushes.back().time + kAfter;
+  } else if (name == "push_y") {
+    p.description = "seven impulses along +Y at the torso, 3 s apart (8, 10, 11, 12 x4 N·s)";
+    p.run.pushes = series(kFirst, kSpacing, {8, 10, 11, 12, 12, 12, 12}, Eigen::Vector3d::UnitY());
+    p.run.duration = p.run.pushes.back().time + kAfter;
+  } else if (name == "push_sweep") {
+    p.description = "largest single impulse survived along +X, -X, +Y, -Y (bisection)";
+    p.sweep = true;
+    p.run.duration = p.sweep_params.push_time + p.sweep_params.observe;
+  } else {
+    std::string known;
+    for (const std::string& n : scenarioNames()) known += (known.empty() ? "" : ", ") + n;
+    throw std::invalid_argument("unknown scenario '" + name + "' (known: " + known + ")");
+  }
+  return p;
+}
+
+void setParameter(ScenarioParams& p, const std::string& key, const std::string& value) {
+  for (const Parameter& par : parameters()) {
+    if (key == par.key) {
+      par.set(p, key, value);
+      return;
+    }
+  }
+  std::string keys;
+  for (const Parameter& par : parameters()) keys += (keys.empty() ? "" : ", ") + std::string(par.key);
+  throw std::invalid_argument("unknown parameter '" + key + "' (known: " + keys + ")");
+}
+
+void applyAssignment(ScenarioParams& p, const std::string& assignment) {
+  const std::size_t eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0) {
+    throw std::invalid_argument("--set '" + assignment + "': expected key=value");
+  }
+  setParameter(p, assignment.substr(0, eq), assignment.substr(eq + 1));
+}
+
+void applyParameterFile(ScenarioParams& p, const std::string& yaml_path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(yaml_path);
+  } catch (const YAML::Exception& e) {
+    throw std::invalid_argument(yaml_path + ": " + e.what());
+  }
+  if (!root.IsMap()) throw std::invalid_argument(yaml_path + ": expected a map of parameter: value");
+  for (const auto& kv : root) {
+    const std::string key = kv.first.as<std::string>();
+    const YAML::Node& v = kv.second;
+    std::string text;
+    // A sequence is a list value: items joined by ',', an item that is itself a sequence
+    // (a push [t, ix, iy]) by ':'.
+    if (v.IsSequence()) {
+      for (const auto& item : v) {
+        std::string t;
+        if (item.IsSequence()) {
+          for (const auto& x : item) t += (t.empty() ? "" : ":") + x.as<std::string>();
+        } else if (item.IsScalar()) {
+          t = item.as<std::string>();
+        } else {
+          throw std::invalid_argument(yaml_path + ": parameter '" + key + "': unsupported value");
+        }
+        text += (text.empty() ? "" : ",") + t;
+      }
+      if (text.empty()) text = "none";
+    } else if (v.IsScalar()) {
+      text = v.as<std::string>();
+    } else {
+      throw std::invalid_argument(yaml_path + ": parameter '" + key + "': expected a value or a list");
+    }
+    try {
+      setParameter(p, key, text);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(yaml_path + ": " + e.what());
+    }
+  }
+}
+
+RunOptions runOptions(const ScenarioParams& p) {
+  RunOptions o = p.run;
+  o.scenario = p.name;
+  for (Push& push : o.pushes) {
+    push.ball = p.ball;
+    push.duration = p.push_duration;
+  }
+  return o;
+}
+
+std::vector<std::pair<std::string, std::string>> parameterValues(const ScenarioParams& p) {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const Parameter& par : parameters()) out.emplace_back(par.key, par.get(p));
+  return out;
+}
+
+std::vector<std::pair<std::string, std::string>> parameterHelp() {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const Parameter& par : parameters()) out.emplace_back(par.key, par.help);
+  return out;
+}
+
+}  // namespace hqp::sim

@@ -1,0 +1,57 @@
+#pragma once
+// Named scenarios of the MuJoCo demo (docs/scenarios.md): presets of the paper's Section VI-A
+// (quiet standing, the Table II push series, a push sweep) whose every parameter can be
+// overridden from a YAML file or `--set key=value`. Not real-time code.
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "run.hpp"
+
+namespace hqp::sim {
+
+// Bisection for the largest impulse survived along each direction (push_sweep).
+struct SweepParams {
+  std::vector<std::string> directions = {"+x", "-x", "+y", "-y"};
+  double min_impulse = 4.0;    // N·s, first bracket end (expected to pass)
+  double max_impulse = 40.0;   // N·s, other end (expected to fail)
+  double resolution = 0.25;    // N·s, stop when the bracket is this narrow
+  double push_time = 2.0;      // s after the start of each trial
+  double observe = 3.0;        // s simulated after the push
+  double required = 12.0;      // N·s, the sweep passes when every direction survives this (paper: 12)
+};
+
+struct ScenarioParams {
+  std::string name;
+  std::string description;
+  RunOptions run;                 // duration, pushes, fall/ZMP criteria, video size
+  bool ball = true;                // pushes throw the scene's 5 kg ball (else a force on the torso)
+  double push_duration = 0.01;    // s, force pushes only
+  std::string controller = "hqp"; // hqp | wqp
+  bool noise = false;             // plant.yaml sensor noise
+  unsigned seed = 1;
+  int substeps = 1;               // physics steps per 1 ms tick
+  bool sweep = false;             // push_sweep: bisection instead of one run
+  SweepParams sweep_params;
+};
+
+// The presets, in the order `--list` shows them.
+std::vector<std::string> scenarioNames();
+// Throws std::invalid_argument naming the unknown scenario and the known ones.
+ScenarioParams presetScenario(const std::string& name);
+// One parameter from text (`--set key=value`); throws std::invalid_argument naming the key
+// (unknown key: lists the valid ones) and the bad value.
+void setParameter(ScenarioParams& p, const std::string& key, const std::string& value);
+// `--set key=value` split and applied.
+void applyAssignment(ScenarioParams& p, const std::string& assignment);
+// A YAML map of the same keys (sequences for list values); errors name the file and key.
+void applyParameterFile(ScenarioParams& p, const std::string& yaml_path);
+// The run's options: `run` with the push method applied to every push.
+RunOptions runOptions(const ScenarioParams& p);
+// (key, current value as `--set` would accept it) for every parameter: the run's record.
+std::vector<std::pair<std::string, std::string>> parameterValues(const ScenarioParams& p);
+// (key, meaning) for the help text.
+std::vector<std::pair<std::string, std::string>> parameterHelp();
+
+}  // namespace hqp::sim
