@@ -400,12 +400,23 @@ def fig9(run, out, title, pushes, fall_time, sole_x, sole_y):
             if np.any(bad):
                 y = np.clip(np.nan_to_num(res[bad], nan=floor), floor, None)
                 ax.plot(t[bad], y, "x", color="tab:red", ms=4, label=f"status ≠ optimal ({int(bad.sum())} ticks)")
+        counts = []
+        for lv in levels:
+            st = run.col(f"level{lv}_status")
+            if st is not None:
+                counts.append(f"L{lv} {int((np.nan_to_num(st, nan=0.0) != 0).sum())}")
+        if counts:
+            ax.text(0.01, 0.96, "ticks with QP status ≠ optimal: " + ", ".join(counts), transform=ax.transAxes,
+                    va="top", fontsize=8, color="dimgray", bbox=dict(fc="white", ec="none", alpha=0.7, pad=1))
         m = finite_extreme(t, res, "max")
         if m is not None and m[1] > 0:
             annotate_point(ax, m, f"max {m[1]:.3g} at {m[0]:.2f} s", "tab:purple")
         if np.any(np.isfinite(res)) and np.nanmin(res) <= floor:
-            ax.text(0.01, 0.04, f"values ≤ {floor:g} drawn at {floor:g}", transform=ax.transAxes,
-                    fontsize=8, color="gray")
+            ax.text(0.99, 0.04, f"values ≤ {floor:g} drawn at {floor:g}", transform=ax.transAxes,
+                    ha="right", fontsize=8, color="gray")
+        if np.any(np.isfinite(res)):
+            top_val = max(float(np.nanmax(res)), floor)
+            ax.set_ylim(bottom=min(ax.get_ylim()[0], floor / 3.0), top=top_val * 100.0)  # room for the labels
     mark_events(ax, pushes, fall_time, label=True)
     ax.set_ylabel("task error ‖Ax − b‖²")
     ax.set_xlabel("time (s)")
