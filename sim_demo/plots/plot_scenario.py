@@ -11,6 +11,7 @@ Every column except `time` is optional: what is missing is drawn as a "not logge
 Needs only numpy and matplotlib (Agg).
 """
 import argparse
+import json
 import math
 import os
 import sys
@@ -280,7 +281,7 @@ def fig8(run, out, title, pushes, fall_time):
             ax.text(0.01, 0.95, "right foot pitch: not logged", transform=ax.transAxes, fontsize=8,
                     color="gray", va="top")
     ax.set_ylabel("foot angle (deg)")
-    ax.set_title("(a) right foot pitch (world)", fontsize=10, loc="left")
+    ax.set_title("(a) right foot pitch in the world (left foot thin, roll dashed)", fontsize=10, loc="left")
 
     ax = axes[1]
     cx = run.col("com_x")
@@ -293,8 +294,13 @@ def fig8(run, out, title, pushes, fall_time):
         hi, lo = finite_extreme(t, dx, "max"), finite_extreme(t, dx, "min")
         annotate_point(ax, hi, f"max {hi[1]:+.1f} mm at {hi[0]:.2f} s", "tab:green")
         annotate_point(ax, lo, f"min {lo[1]:+.1f} mm at {lo[0]:.2f} s", "darkgreen", above=False)
-    ax.set_ylabel("CoM x rel. t₀ (mm)")
-    ax.set_title("(b) CoM position along x", fontsize=10, loc="left")
+    cy = run.col("com_y")
+    if cy is not None and len(t) and np.any(np.isfinite(cy)):
+        ref = cy[np.flatnonzero(np.isfinite(cy))[0]]
+        plot_line(ax, t, (cy - ref) * 1000.0, color="olive", lw=0.7, ls="--", alpha=0.8,
+                  label="CoM y − CoM y(t₀)")
+    ax.set_ylabel("CoM rel. t₀ (mm)")
+    ax.set_title("(b) CoM position along x (y dashed)", fontsize=10, loc="left")
 
     ax = axes[2]
     tp, tr = run.col("torso_pitch"), run.col("torso_roll")
@@ -312,7 +318,7 @@ def fig8(run, out, title, pushes, fall_time):
                 annotate_point(ax, m, f"max |roll| {abs(m[1]):.1f}° at {m[0]:.2f} s", "tab:brown",
                                above=False)
     ax.set_ylabel("torso angle (deg)")
-    ax.set_title("(c) torso pitch", fontsize=10, loc="left")
+    ax.set_title("(c) torso pitch (roll dashed)", fontsize=10, loc="left")
 
     for ax in axes:
         mark_events(ax, pushes, fall_time, label=True)
@@ -415,8 +421,9 @@ def fig9(run, out, title, pushes, fall_time, sole_x, sole_y):
             ax.text(0.99, 0.04, f"values ≤ {floor:g} drawn at {floor:g}", transform=ax.transAxes,
                     ha="right", fontsize=8, color="gray")
         if np.any(np.isfinite(res)):
-            top_val = max(float(np.nanmax(res)), floor)
-            ax.set_ylim(bottom=min(ax.get_ylim()[0], floor / 3.0), top=top_val * 100.0)  # room for the labels
+            clipped = np.clip(res, floor, None)
+            top_val = float(np.nanmax(clipped))
+            ax.set_ylim(float(np.nanmin(clipped)) / 10.0, top_val * 100.0)  # room for the labels
     mark_events(ax, pushes, fall_time, label=True)
     ax.set_ylabel("task error ‖Ax − b‖²")
     ax.set_xlabel("time (s)")
@@ -458,14 +465,14 @@ def fig13(run, out, title, pushes, fall_time):
     else:
         pos = np.clip(us, 0.1, None)  # log axis
         plot_line(ax, t, pos, color="lightsteelblue", lw=0.6, label="compute time per tick")
-        if len(us) >= 200:  # the trend under the per-tick scatter
+        if len(us) >= 200:  # the trend under the per-tick scatter; a median ignores the outliers
             w = 100
-            fin = np.isfinite(us)
-            cs = np.concatenate(([0.0], np.cumsum(np.where(fin, us, 0.0))))
-            cn = np.concatenate(([0], np.cumsum(fin)))
-            with np.errstate(invalid="ignore", divide="ignore"):
-                avg = (cs[w:] - cs[:-w]) / (cn[w:] - cn[:-w])
-            plot_line(ax, t[w - 1:], avg, color="tab:blue", lw=1.0, label=f"mean of {w} ticks")
+            nb = len(us) // w
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN blocks stay NaN
+                med = np.nanmedian(us[:nb * w].reshape(nb, w), axis=1)
+            tc = t[:nb * w].reshape(nb, w).mean(axis=1)
+            ax.plot(tc, med, color="tab:blue", lw=1.0, drawstyle="steps-mid", label=f"median of {w} ticks")
         ax.axhline(stats["mean"], color="tab:green", lw=1.0, label=f"mean {stats['mean']:.1f} µs")
         ax.axhline(stats["p999"], color="tab:orange", lw=1.0, ls="--",
                    label=f"99.9 % {stats['p999']:.1f} µs")
@@ -480,7 +487,8 @@ def fig13(run, out, title, pushes, fall_time):
 
         v = np.clip(us[np.isfinite(us)], 0.1, None)
         bins = np.logspace(math.log10(v.min()), math.log10(max(v.max(), v.min() * 1.01)), 60)
-        axh.hist(v, bins=bins, color="tab:blue", alpha=0.8)
+        counts, _, _ = axh.hist(v, bins=bins, color="tab:blue", alpha=0.8)
+        axh.set_ylim(0.5, 30.0 * max(float(counts.max()), 1.0))  # room for the legend
         axh.set_xscale("log")
         axh.set_yscale("log")
         axh.axvline(stats["mean"], color="tab:green", lw=1.0, label=f"mean {stats['mean']:.1f} µs")
@@ -503,6 +511,33 @@ def fig13(run, out, title, pushes, fall_time):
 
 # ---- command line ---------------------------------------------------------------------------------
 
+def read_summary(path, csv_path, stem):
+    """The run's summary.json as a dict; None if absent or not about this run."""
+    explicit = path is not None
+    path = path or os.path.join(os.path.dirname(os.path.abspath(csv_path)), "summary.json")
+    try:
+        with open(path, "r") as f:
+            d = json.load(f)
+    except (OSError, ValueError):
+        return None
+    if not isinstance(d, dict):
+        return None
+    if explicit:
+        return d
+    csv_name = os.path.basename(str((d.get("files") or {}).get("csv", "")))
+    return d if csv_name == os.path.basename(csv_path) or d.get("scenario") == stem else None
+
+
+def summary_pushes(summ):
+    out = []
+    for p in summ.get("pushes") or []:
+        try:
+            out.append((float(p["time"]), impulse_label(p.get("impulse", [0, 0, 0]))))
+        except (KeyError, TypeError, ValueError):
+            pass
+    return sorted(out)
+
+
 def parse_pushes(text):
     out = []
     for item in text.split(","):
@@ -520,7 +555,10 @@ def main(argv=None):
     ap.add_argument("--pushes", help="push times T1,T2,... in s (default: detected from the CSV)")
     ap.add_argument("--sole-x", type=float, default=110.0, help="sole half-length in x, mm (default 110)")
     ap.add_argument("--sole-y", type=float, default=50.0, help="sole half-width in y, mm (default 50)")
-    ap.add_argument("--fall-time", type=float, help="time of a fall (default: detected from the last row)")
+    ap.add_argument("--fall-time", type=float,
+                    help="time of a fall (default: from the run's summary.json, else the last row's torso)")
+    ap.add_argument("--summary", help="the run's summary.json (default: summary.json next to the CSV, if it "
+                                      "names this CSV or scenario)")
     a = ap.parse_args(argv)
 
     try:
@@ -536,12 +574,26 @@ def main(argv=None):
     except ValueError:
         print(f"plot_scenario: --pushes wants comma-separated times in s, got '{a.pushes}'", file=sys.stderr)
         return 2
-    fall_time = a.fall_time if a.fall_time is not None else detect_fall(run)
+    summ = read_summary(a.summary, a.csv, stem)
+    if a.summary and summ is None:
+        print(f"plot_scenario: cannot use {a.summary}", file=sys.stderr)
+        return 2
+    if not pushes and not a.pushes and summ:
+        pushes = summary_pushes(summ)
+    fall_time = a.fall_time
+    if fall_time is None and summ and summ.get("fell"):
+        ft = summ.get("fall_time")
+        fall_time = float(ft) if isinstance(ft, (int, float)) else (float(run.t[-1]) if len(run) else None)
+    if fall_time is None and not (summ and summ.get("fell") is False):
+        fall_time = detect_fall(run)  # a fall by contact only shows in the summary
     if run.dropped:
         print(f"plot_scenario: skipped {run.dropped} incomplete line(s) of {a.csv}", file=sys.stderr)
     if len(run) == 0:
         print(f"plot_scenario: {a.csv} has no data rows; the figures are empty", file=sys.stderr)
 
+    times = ", ".join(f"{p[0]:.2f}" for p in pushes)
+    print(f"{a.csv}: {len(run)} rows, {len(pushes)} push(es)" + (f" at {times} s" if pushes else "") +
+          (f", fall at {fall_time:.2f} s" if fall_time is not None else ", no fall"))
     fig8(run, os.path.join(a.out, f"{stem}_fig8.png"), title, pushes, fall_time)
     fig9(run, os.path.join(a.out, f"{stem}_fig9.png"), title, pushes, fall_time, a.sole_x, a.sole_y)
     fig13(run, os.path.join(a.out, f"{stem}_fig13.png"), title, pushes, fall_time)

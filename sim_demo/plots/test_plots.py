@@ -6,6 +6,8 @@ columns, no foot angles, a ball launch, a partial last line, NaN CoPs), and a he
 Checks the PNGs (signature, size in pixels and bytes), the push detection and the min/max
 decimation against values known by construction, and the rows of the markdown table.
 """
+import contextlib
+import io
 import json
 import os
 import struct
@@ -25,10 +27,13 @@ JOINTS = [f"{s}_{j}" for s in ("l", "r") for j in
 FAILURES = []
 
 
-def check(cond, what):
+def check(cond, what, r=None):
+    """Records a check; r (a finished script run) is printed when the check fails."""
     print(("ok   " if cond else "FAIL ") + what)
     if not cond:
         FAILURES.append(what)
+        if r is not None:
+            print(f"     exit {r.returncode}\n     stdout: {r.stdout}\n     stderr: {r.stderr}")
 
 
 def base_columns(t):
@@ -148,10 +153,23 @@ def check_pngs(outdir, stem):
 
 
 def run_script(args):
-    r = subprocess.run([PY] + args, capture_output=True, text=True, timeout=300)
-    if r.returncode != 0:
-        print(r.stdout, r.stderr)
-    return r
+    return subprocess.run([PY] + args, capture_output=True, text=True, timeout=300)
+
+
+class Result:
+    def __init__(self, returncode, stdout, stderr):
+        self.returncode, self.stdout, self.stderr = returncode, stdout, stderr
+
+
+def run_inprocess(main, args):
+    """A script's main() in this process (saves importing matplotlib per run); same CLI parsing."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            rc = main(args)
+        except SystemExit as e:
+            rc = e.code
+    return Result(rc, out.getvalue(), err.getvalue())
 
 
 def test_plots(tmp):
@@ -166,24 +184,35 @@ def test_plots(tmp):
     script = os.path.join(HERE, "plot_scenario.py")
 
     r = run_script([script, full, "--out", out, "--title", "push_x (synthetic)"])
-    check(r.returncode == 0, "plot_scenario on a full run exits 0")
+    check(r.returncode == 0, "plot_scenario on a full run exits 0", r)
     check_pngs(out, "push_x")
 
-    r = run_script([script, fall, "--out", out])
-    check(r.returncode == 0, "plot_scenario on a truncated run with NaNs and missing columns exits 0")
+    r = run_inprocess(plot_scenario.main, [fall, "--out", out])
+    check(r.returncode == 0, "plot_scenario on a truncated run with NaNs and missing columns exits 0", r)
     check("incomplete line" in r.stderr, "the partial last line is reported")
     check_pngs(out, "push_y_fall")
 
-    r = run_script([script, full, "--out", out, "--pushes", "1.0,3.0", "--sole-x", "100", "--sole-y", "45"])
-    check(r.returncode == 0, "plot_scenario with --pushes and sole limits exits 0")
+    r = run_inprocess(plot_scenario.main, [full, "--out", out, "--pushes", "1.0,3.0", "--sole-x", "100",
+                                           "--sole-y", "45"])
+    check(r.returncode == 0, "plot_scenario with --pushes and sole limits exits 0", r)
 
-    r = run_script([script, empty, "--out", out])
-    check(r.returncode == 0, "plot_scenario on a header-only CSV exits 0")
+    check("2 push(es) at 1.00, 3.00 s, no fall" in r.stdout, "the pushes of the full run are reported")
+    # A fall by contact is only in the run's summary.json (found next to the CSV by its scenario).
+    sub = os.path.join(tmp, "contact_fall")
+    os.makedirs(sub)
+    full_run(os.path.join(sub, "push_x.csv"))
+    with open(os.path.join(sub, "summary.json"), "w") as f:
+        json.dump({"scenario": "push_x", "fell": True, "fall_time": 5.5, "fall_reason": "shank contact"}, f)
+    r = run_inprocess(plot_scenario.main, [os.path.join(sub, "push_x.csv"), "--out", out])
+    check(r.returncode == 0 and "fall at 5.50 s" in r.stdout, "the fall time is taken from summary.json", r)
+
+    r = run_inprocess(plot_scenario.main, [empty, "--out", out])
+    check(r.returncode == 0, "plot_scenario on a header-only CSV exits 0", r)
     check(all(os.path.isfile(os.path.join(out, f"empty_{f}.png")) for f in ("fig8", "fig9", "fig13")),
           "a header-only CSV still gives three PNGs")
 
-    r = run_script([script, os.path.join(tmp, "missing.csv"), "--out", out])
-    check(r.returncode == 2 and "missing.csv" in r.stderr, "a missing CSV is a clear error (exit 2)")
+    r = run_inprocess(plot_scenario.main, [os.path.join(tmp, "missing.csv"), "--out", out])
+    check(r.returncode == 2 and "missing.csv" in r.stderr, "a missing CSV is a clear error (exit 2)", r)
 
     # Push and fall detection against the values put in by construction.
     run = plot_scenario.Run(full)
@@ -239,7 +268,7 @@ def test_table(tmp):
     md = os.path.join(tmp, "out", "results.md")
     script = os.path.join(HERE, "summary_table.py")
     r = run_script([script, os.path.join(tmp, "runs"), lst, "--md", md, "--paper"])
-    check(r.returncode == 0, "summary_table exits 0")
+    check(r.returncode == 0, "summary_table exits 0", r)
     check(os.path.isfile(md), "summary_table --md writes the file")
     text = open(md).read() if os.path.isfile(md) else ""
     check(text == r.stdout, "the file holds the printed table")
@@ -257,9 +286,9 @@ def test_table(tmp):
     check(st[2] == "PASS" and st[3] == "–", f"a sparse summary still gives a row: {st}")
     check(any(k.startswith("paper") for k in rows), "--paper adds the paper's row")
     r = run_script([script, os.path.join(tmp, "runs"), "--strict"])
-    check(r.returncode == 1, "--strict exits 1 when a run failed")
+    check(r.returncode == 1, "--strict exits 1 when a run failed", r)
     r = run_script([script, os.path.join(tmp, "nope.json")])
-    check(r.returncode == 2 and "nope.json" in r.stderr, "a missing summary is a clear error (exit 2)")
+    check(r.returncode == 2 and "nope.json" in r.stderr, "a missing summary is a clear error (exit 2)", r)
 
 
 def main():
