@@ -512,20 +512,28 @@ def fig13(run, out, title, pushes, fall_time):
 # ---- command line ---------------------------------------------------------------------------------
 
 def read_summary(path, csv_path, stem):
-    """The run's summary.json as a dict; None if absent or not about this run."""
-    explicit = path is not None
-    path = path or os.path.join(os.path.dirname(os.path.abspath(csv_path)), "summary.json")
-    try:
-        with open(path, "r") as f:
-            d = json.load(f)
-    except (OSError, ValueError):
-        return None
-    if not isinstance(d, dict):
-        return None
-    if explicit:
-        return d
-    csv_name = os.path.basename(str((d.get("files") or {}).get("csv", "")))
-    return d if csv_name == os.path.basename(csv_path) or d.get("scenario") == stem else None
+    """The run's record from a summary JSON (an object, a list, or {"runs": [...]}); None if absent.
+    Without `path`: summary.json, <stem>.json or <stem>_summary.json next to the CSV, and only a
+    record that names this CSV (files.csv) or this scenario."""
+    here = os.path.dirname(os.path.abspath(csv_path))
+    candidates = [path] if path else [os.path.join(here, n) for n in
+                                      ("summary.json", f"{stem}.json", f"{stem}_summary.json")]
+    for c in candidates:
+        try:
+            with open(c, "r") as f:
+                d = json.load(f)
+        except (OSError, ValueError):
+            continue
+        if isinstance(d, dict) and isinstance(d.get("runs"), list):
+            d = d["runs"]
+        records = [r for r in (d if isinstance(d, list) else [d]) if isinstance(r, dict)]
+        for r in records:
+            csv_name = os.path.basename(str((r.get("files") or {}).get("csv", "")))
+            if csv_name == os.path.basename(csv_path) or r.get("scenario") == stem:
+                return r
+        if path and len(records) == 1:  # named explicitly: trust it
+            return records[0]
+    return None
 
 
 def summary_pushes(summ):

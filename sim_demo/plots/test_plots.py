@@ -263,8 +263,12 @@ def test_table(tmp):
         json.dump(summary("push_y", False, fall_time=7.25, fall_reason="torso roll", controller="wqp",
                           max_foot_pitch_deg=None, tick_p999_us=None), f)
     lst = os.path.join(tmp, "list.json")
-    with open(lst, "w") as f:  # a list of runs, with most keys missing
-        json.dump([{"scenario": "stand", "passed": True}], f)
+    with open(lst, "w") as f:  # a list of runs, with most keys missing, and a push_sweep record
+        json.dump([{"scenario": "stand", "passed": True},
+                   {"scenario": "push_sweep", "controller": "hqp", "passed": False, "required_impulse": 12.0,
+                    "directions": [{"direction": "+x", "largest_passed": 14.25, "smallest_failed": 15.0},
+                                   {"direction": "-y", "largest_passed": 9.5, "smallest_failed": 10.0}],
+                    "tick_max_us": 900.0, "tick_p999_us_worst_trial": 120.0}], f)
     md = os.path.join(tmp, "out", "results.md")
     script = os.path.join(HERE, "summary_table.py")
     r = run_script([script, os.path.join(tmp, "runs"), lst, "--md", md, "--paper"])
@@ -273,7 +277,7 @@ def test_table(tmp):
     text = open(md).read() if os.path.isfile(md) else ""
     check(text == r.stdout, "the file holds the printed table")
     lines = [ln for ln in text.splitlines() if ln.startswith("|")]
-    check(len(lines) == 2 + 4, f"header, separator and 4 rows ({len(lines)} lines)")
+    check(len(lines) == 2 + 5, f"header, separator and 5 rows ({len(lines)} lines)")
     rows = {ln.split("|")[1].strip(): [c.strip() for c in ln.split("|")[1:-1]] for ln in lines[2:]}
     check(rows.get("push_x", [None])[:3] == ["push_x", "hqp", "PASS"], f"push_x row: {rows.get('push_x')}")
     px = rows.get("push_x", [""] * 9)
@@ -285,6 +289,22 @@ def test_table(tmp):
     st = rows.get("stand", [""] * 9)
     check(st[2] == "PASS" and st[3] == "–", f"a sparse summary still gives a row: {st}")
     check(any(k.startswith("paper") for k in rows), "--paper adds the paper's row")
+    sw = rows.get("push_sweep", [""] * 9)
+    check(sw[2] == "FAIL (largest survived, N·s: +x 14.2, -y 9.5)" and sw[7] == "– / 120 µs (worst run)",
+          f"push_sweep row: {sw}")
+
+    # --wide: QP status counts in the simulator's spelling (toString of QpStatus) are summed.
+    with open(os.path.join(tmp, "wide.json"), "w") as f:
+        json.dump(summary("push_x", False, fell=False, zmp_inside=False, lowest_level_error_max=1234.5, tick_max_us=950.0,
+                          level_status_counts=[{"Optimal": 9, "Infeasible": 1, "IterationLimit": 2,
+                                                "NumericalFailure": 0},
+                                               {"Optimal": 12, "Infeasible": 0, "IterationLimit": 0,
+                                                "NumericalFailure": 3}]), f)
+    r = run_script([script, os.path.join(tmp, "wide.json"), "--wide"])
+    wl = [ln for ln in r.stdout.splitlines() if ln.startswith("| push_x")]
+    cells = [c.strip() for c in wl[0].split("|")[1:-1]] if wl else []
+    check(cells[2:3] == ["FAIL (ZMP left a sole)"] and cells[9:] == ["0.5°", "1.23e+03", "6", "950 µs"],
+          f"--wide row: {cells}", r)
     r = run_script([script, os.path.join(tmp, "runs"), "--strict"])
     check(r.returncode == 1, "--strict exits 1 when a run failed", r)
     r = run_script([script, os.path.join(tmp, "nope.json")])
