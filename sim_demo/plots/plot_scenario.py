@@ -57,9 +57,12 @@ class Run:
             try:
                 self.data = np.loadtxt(rows, delimiter=",", dtype=float, ndmin=2)
             except ValueError:
-                self.data = np.genfromtxt(rows, delimiter=",", dtype=float, ndmin=2)  # slow, tolerant
+                self.data = np.genfromtxt(rows, delimiter=",", dtype=float).reshape(len(rows), -1)  # slow, tolerant
         else:
             self.data = np.zeros((0, len(self.names)))
+        ok = np.isfinite(self.data[:, self.index["time"]])  # a row without a time cannot be placed
+        self.dropped += int((~ok).sum())
+        self.data = self.data[ok]
         self.t = self.data[:, self.index["time"]]
 
     def __len__(self):

@@ -211,6 +211,12 @@ def test_plots(tmp):
     check(all(os.path.isfile(os.path.join(out, f"empty_{f}.png")) for f in ("fig8", "fig9", "fig13")),
           "a header-only CSV still gives three PNGs")
 
+    odd = os.path.join(tmp, "odd.csv")  # empty and non-numeric fields, a row without a time
+    with open(odd, "w") as f:
+        f.write("time,com_x,tick_us,l_zmp_meas_x\n0.000,0.1,50,\n0.001,0.1,x,0.01\n,0.1,60,nan\n0.003,0.1,inf,0\n")
+    r = run_inprocess(plot_scenario.main, [odd, "--out", out])
+    check(r.returncode == 0 and "3 rows" in r.stdout, "odd fields become NaN, a row without a time is skipped", r)
+
     r = run_inprocess(plot_scenario.main, [os.path.join(tmp, "missing.csv"), "--out", out])
     check(r.returncode == 2 and "missing.csv" in r.stderr, "a missing CSV is a clear error (exit 2)", r)
 
