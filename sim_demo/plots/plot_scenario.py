@@ -268,7 +268,7 @@ def fig8(run, out, title, pushes, fall_time):
 
     ax = axes[0]
     rp, lp = run.col("r_foot_pitch"), run.col("l_foot_pitch")
-    rr, lr = run.col("r_foot_roll"), run.col("l_foot_roll")
+    rr = run.col("r_foot_roll")
     if rp is None and lp is None:
         not_logged(ax, "foot pitch (r_foot_pitch)")
     else:

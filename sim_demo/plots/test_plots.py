@@ -301,7 +301,8 @@ def test_table(tmp):
 
     # --wide: QP status counts in the simulator's spelling (toString of QpStatus) are summed.
     with open(os.path.join(tmp, "wide.json"), "w") as f:
-        json.dump(summary("push_x", False, fell=False, zmp_inside=False, lowest_level_error_max=1234.5, tick_max_us=950.0,
+        json.dump(summary("push_x", False, fell=False, zmp_inside=False, lowest_level_error_max=1234.5,
+                          tick_max_us=950.0,
                           level_status_counts=[{"Optimal": 9, "Infeasible": 1, "IterationLimit": 2,
                                                 "NumericalFailure": 0},
                                                {"Optimal": 12, "Infeasible": 0, "IterationLimit": 0,
