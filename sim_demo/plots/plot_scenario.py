@@ -66,6 +66,19 @@ class Run:
         self.dropped += int((~ok).sum())
         self.data = self.data[ok]
         self.t = self.data[:, self.index["time"]]
+        self.full = self.data
+
+    def first(self, name):
+        """First finite value of a column over the whole run (t0 reference, also inside a window)."""
+        c = self.full[:, self.index[name]] if name in self.index else np.zeros(0)
+        i = np.flatnonzero(np.isfinite(c))
+        return float(c[i[0]]) if len(i) else float("nan")
+
+    def window(self, t0, t1):
+        """Keeps the rows with t0 <= time <= t1 (for plotting a time window)."""
+        keep = (self.t >= t0) & (self.t <= t1)
+        self.data = self.data[keep]
+        self.t = self.t[keep]
 
     def __len__(self):
         return self.data.shape[0]
@@ -255,7 +268,7 @@ def side_legend(ax):
 
 
 def suptitle(fig, title, what, run, fall_time):
-    dur = f"{run.t[-1] - run.t[0]:.2f} s" if len(run) else "no data"
+    dur = f"t = {run.t[0]:.2f} … {run.t[-1]:.2f} s" if len(run) else "no data"
     end = f", FELL at {fall_time:.2f} s" if fall_time is not None else ""
     fig.suptitle(f"{title}: {what}  ({dur}{end})", fontsize=12)
 
@@ -293,7 +306,7 @@ def fig8(run, out, title, pushes, fall_time):
     if cx is None or len(t) == 0 or not np.any(np.isfinite(cx)):
         not_logged(ax, "CoM x (com_x)")
     else:
-        ref = cx[np.flatnonzero(np.isfinite(cx))[0]]
+        ref = run.first("com_x")
         dx = (cx - ref) * 1000.0
         plot_line(ax, t, dx, color="tab:green", lw=1.0, label="CoM x − CoM x(t₀)")
         hi, lo = finite_extreme(t, dx, "max"), finite_extreme(t, dx, "min")
@@ -301,7 +314,7 @@ def fig8(run, out, title, pushes, fall_time):
         annotate_point(ax, lo, f"min {lo[1]:+.1f} mm at {lo[0]:.2f} s", "darkgreen", above=False)
     cy = run.col("com_y")
     if cy is not None and len(t) and np.any(np.isfinite(cy)):
-        ref = cy[np.flatnonzero(np.isfinite(cy))[0]]
+        ref = run.first("com_y")
         plot_line(ax, t, (cy - ref) * 1000.0, color="olive", lw=0.7, ls="--", alpha=0.8,
                   label="CoM y − CoM y(t₀)")
     ax.set_ylabel("CoM rel. t₀ (mm)")
@@ -566,6 +579,7 @@ def main(argv=None):
     ap.add_argument("--out", required=True, help="output directory for the PNGs")
     ap.add_argument("--title", help="figure title (default: the CSV's stem)")
     ap.add_argument("--pushes", help="push times T1,T2,... in s (default: detected from the CSV)")
+    ap.add_argument("--window", help="plot only T0:T1 (s), e.g. 4.5:7 to look at one push")
     ap.add_argument("--sole-x", type=float, default=110.0, help="sole half-length in x, mm (default 110)")
     ap.add_argument("--sole-y", type=float, default=50.0, help="sole half-width in y, mm (default 50)")
     ap.add_argument("--fall-time", type=float,
@@ -582,6 +596,14 @@ def main(argv=None):
     os.makedirs(a.out, exist_ok=True)
     stem = os.path.splitext(os.path.basename(a.csv))[0]
     title = a.title or stem
+    suffix = ""
+    if a.window:
+        try:
+            w0, w1 = (float(x) for x in a.window.split(":"))
+        except ValueError:
+            print(f"plot_scenario: --window wants T0:T1 in s, got '{a.window}'", file=sys.stderr)
+            return 2
+        suffix = f"_{w0:g}-{w1:g}s"
     try:
         pushes = parse_pushes(a.pushes) if a.pushes else detect_pushes(run)
     except ValueError:
@@ -607,9 +629,14 @@ def main(argv=None):
     times = ", ".join(f"{p[0]:.2f}" for p in pushes)
     print(f"{a.csv}: {len(run)} rows, {len(pushes)} push(es)" + (f" at {times} s" if pushes else "") +
           (f", fall at {fall_time:.2f} s" if fall_time is not None else ", no fall"))
-    fig8(run, os.path.join(a.out, f"{stem}_fig8.png"), title, pushes, fall_time)
-    fig9(run, os.path.join(a.out, f"{stem}_fig9.png"), title, pushes, fall_time, a.sole_x, a.sole_y)
-    fig13(run, os.path.join(a.out, f"{stem}_fig13.png"), title, pushes, fall_time)
+    if a.window:  # events are found on the whole run, then the rows are cut
+        run.window(w0, w1)
+        pushes = [p for p in pushes if w0 <= p[0] <= w1]
+        if fall_time is not None and not w0 <= fall_time <= w1:
+            fall_time = None
+    fig8(run, os.path.join(a.out, f"{stem}{suffix}_fig8.png"), title, pushes, fall_time)
+    fig9(run, os.path.join(a.out, f"{stem}{suffix}_fig9.png"), title, pushes, fall_time, a.sole_x, a.sole_y)
+    fig13(run, os.path.join(a.out, f"{stem}{suffix}_fig13.png"), title, pushes, fall_time)
     return 0
 
 

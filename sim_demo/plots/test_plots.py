@@ -195,6 +195,9 @@ def test_plots(tmp):
     r = run_inprocess(plot_scenario.main, [full, "--out", out, "--pushes", "1.0,3.0", "--sole-x", "100",
                                            "--sole-y", "45"])
     check(r.returncode == 0, "plot_scenario with --pushes and sole limits exits 0", r)
+    r = run_inprocess(plot_scenario.main, [full, "--out", out, "--window", "2.5:4"])
+    check(r.returncode == 0 and all(os.path.isfile(os.path.join(out, f"push_x_2.5-4s_{f}.png"))
+                                    for f in ("fig8", "fig9", "fig13")), "--window 2.5:4 gives its own PNGs", r)
 
     check("2 push(es) at 1.00, 3.00 s, no fall" in r.stdout, "the pushes of the full run are reported")
     # A fall by contact is only in the run's summary.json (found next to the CSV by its scenario).
