@@ -481,7 +481,12 @@ def fig13(run, out, title, pushes, fall_time):
         not_logged(ax, "compute time (tick_us)")
         not_logged(axh, "compute time")
     else:
-        pos = np.clip(us, 0.1, None)  # log axis
+        fin = us[np.isfinite(us)]
+        # Log axes start at 0.3 x the median: near-zero ticks (safe mode skips the QPs) would
+        # otherwise squash the figure; they are counted in a note instead.
+        lo = max(0.3 * float(np.median(fin)), 0.01)
+        below = int((fin < lo).sum())
+        pos = np.clip(us, lo, None)
         plot_line(ax, t, pos, color="lightsteelblue", lw=0.6, label="compute time per tick")
         if len(us) >= 200:  # the trend under the per-tick scatter; a median ignores the outliers
             w = 100
@@ -497,13 +502,20 @@ def fig13(run, out, title, pushes, fall_time):
         ax.axhline(TICK_BUDGET_US, color="tab:red", lw=1.2, label=f"budget {TICK_BUDGET_US:g} µs (1 kHz)")
         mx = finite_extreme(t, us, "max")
         ax.plot([mx[0]], [max(mx[1], 0.1)], "v", color="black", ms=6, label=f"max {stats['max']:.1f} µs")
+        safe = run.col("safe_mode")
+        if safe is not None and len(t):
+            for i, (a, b) in enumerate(segments(np.nan_to_num(safe, nan=0.0) > 0.5)):
+                ax.axvspan(t[a], t[min(b, len(t) - 1)], color="tab:orange", alpha=0.2, lw=0,
+                           label="safe mode" if i == 0 else None)
+        if below:
+            ax.text(0.01, 0.03, f"{below} tick(s) below {lo:.3g} µs drawn at the axis", transform=ax.transAxes,
+                    fontsize=8, color="dimgray", bbox=dict(fc="white", ec="none", alpha=0.7, pad=1))
         ax.set_yscale("log")
-        lo = max(0.5 * float(np.nanmin(pos)), 0.1)
         ax.set_ylim(lo, 10.0 * max(TICK_BUDGET_US, stats["max"]))  # a decade of room for the legend
         ax.legend(loc="upper right", fontsize=8, ncol=2)
         mark_events(ax, pushes, fall_time)
 
-        v = np.clip(us[np.isfinite(us)], 0.1, None)
+        v = np.clip(fin, lo, None)
         bins = np.logspace(math.log10(v.min()), math.log10(max(v.max(), v.min() * 1.01)), 60)
         counts, _, _ = axh.hist(v, bins=bins, color="tab:blue", alpha=0.8)
         axh.set_ylim(0.5, 30.0 * max(float(counts.max()), 1.0))  # room for the legend
@@ -514,7 +526,8 @@ def fig13(run, out, title, pushes, fall_time):
         axh.axvline(stats["max"], color="black", lw=1.0, ls=":", label=f"max {stats['max']:.1f} µs")
         axh.axvline(TICK_BUDGET_US, color="tab:red", lw=1.2, label=f"budget {TICK_BUDGET_US:g} µs")
         axh.legend(loc="upper right", fontsize=8)
-        axh.set_title(f"{stats['n']} ticks, {stats['over']} over budget", fontsize=10, loc="left")
+        axh.set_title(f"{stats['n']} ticks, {stats['over']} over budget" +
+                      (f", {below} in the first bin" if below else ""), fontsize=10, loc="left")
     ax.set_ylabel("compute time (µs)")
     ax.set_title("controller compute time per 1 ms tick", fontsize=10, loc="left")
     ax.grid(True, which="both", alpha=0.25)
