@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # The main job (see README): installs the Debian packages, builds, and runs Walker3 in MuJoCo 2.2
-# under the balance controller: 10 s of quiet standing, then a 10 N·s push along +X with a
-# headless MP4. Outputs (CSV logs, summary, video) go to out/. Extra arguments go to both runs.
+# under the balance controller through the paper's Section VI-A scenarios: quiet standing, the
+# push_x and push_y series (with a headless MP4 of push_x) and the push sweep. Prints the summary
+# table; everything (CSV, JSON, markdown, PNG plots, MP4) goes to out/ (docs/scenarios.md).
+# Extra arguments go to sim_demo, e.g. `--controller wqp` or `--set noise=true`.
+# Exit code: 0 when every scenario passed, 1 when one failed, 2 on an error.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build="${HQP_BUILD_DIR:-$root/build}"
@@ -9,11 +12,11 @@ out="${HQP_OUT_DIR:-$root/out}"
 
 bash "$root/scripts/setup.sh" --demo
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release
-cmake --build "$build" -j"$(nproc)" --target hqp_sim hqp_demo
+cmake --build "$build" -j"$(nproc)" --target sim_demo
 
-echo "== Walker3 model =="
-"$build/sim_demo/hqp_demo" --iterations 1000 | tail -n 4
-echo "== stand: 10 s of quiet standing =="
-"$build/sim_demo/hqp_sim" --scenario stand --duration 10 --out "$out/stand" "$@"
-echo "== push: 10 N·s along +X at t = 1 s (video in $out/push_x_10) =="
-"$build/sim_demo/hqp_sim" --scenario stand --duration 4 --push 1:10:0 --out "$out/push_x_10" --video "$@"
+status=0
+"$build/sim_demo/sim_demo" --scenario stand --scenario push_x --scenario push_y --scenario push_sweep \
+  --video-only push_x --out "$out" "$@" || status=$?
+echo
+echo "== outputs in $out: summary.md / summary.json (table), <scenario>/ (CSV, summary.json, PNG plots), push_x/push_x.mp4 =="
+exit $status

@@ -26,7 +26,7 @@ struct ScenarioParams {
   std::string name;
   std::string description;
   RunOptions run;                 // duration, pushes, fall/ZMP criteria, video size
-  bool ball = true;                // pushes throw the scene's 5 kg ball (else a force on the torso)
+  bool ball = false;               // pushes throw the scene's 5 kg ball instead of a force on the torso
   double push_duration = 0.01;    // s, force pushes only
   std::string controller = "hqp"; // hqp | wqp
   bool noise = false;             // plant.yaml sensor noise

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Plots of one hqp_sim run (docs/simulation.md lists the CSV columns).
+"""Plots of one sim_demo run (docs/simulation.md lists the CSV columns).
 
 Writes, for RUN.csv with stem S:
   DIR/S_fig8.png   right-foot pitch, CoM x, torso pitch over time with the pushes (paper Fig. 8)
@@ -587,8 +587,8 @@ def parse_pushes(text):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description="Plots (paper Fig. 8, 9, 13) of one hqp_sim CSV log.")
-    ap.add_argument("csv", help="the run's CSV log (hqp_sim --out DIR writes DIR/<scenario>.csv)")
+    ap = argparse.ArgumentParser(description="Plots (paper Fig. 8, 9, 13) of one sim_demo CSV log.")
+    ap.add_argument("csv", help="the run's CSV log (sim_demo --out DIR writes DIR/<scenario>/<scenario>.csv)")
     ap.add_argument("--out", required=True, help="output directory for the PNGs")
     ap.add_argument("--title", help="figure title (default: the CSV's stem)")
     ap.add_argument("--pushes", help="push times T1,T2,... in s (default: detected from the CSV)")

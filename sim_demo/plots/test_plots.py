@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Self-test of plot_scenario.py and summary_table.py on synthetic data (ctest: sim_plots).
+"""Self-test of plot_scenario.py on synthetic data (ctest: sim_plots).
 
 Synthetic runs: a full controller run with every optional column, a PD run that falls (no driver
 columns, no foot angles, a ball launch, a partial last line, NaN CoPs), and a header-only file.
@@ -37,7 +37,7 @@ def check(cond, what, r=None):
 
 
 def base_columns(t):
-    """The columns every hqp_sim run writes (docs/simulation.md), with plausible values."""
+    """The columns every sim_demo run writes (docs/simulation.md), with plausible values."""
     n = len(t)
     c = {"time": t}
     for j in JOINTS:
@@ -249,82 +249,9 @@ def test_plots(tmp):
     check(np.any(np.isnan(yd[(td > 20.1) & (td < 20.9)])), "decimation keeps the NaN gap")
 
 
-def summary(scenario, passed, **kw):
-    s = {"scenario": scenario, "controller": "hqp", "passed": passed, "fell": not passed,
-         "fall_time": None, "fall_reason": "", "duration_s": 26.0, "max_torso_pitch_deg": 12.1,
-         "max_torso_roll_deg": 0.5, "com_x_min_mm": -20.0, "com_x_max_mm": 55.0, "max_foot_pitch_deg": 0.4,
-         "zmp_inside": True, "zmp_margin_mm": 3.2, "tick_mean_us": 30.1, "tick_max_us": 200.0,
-         "tick_p999_us": 90.0, "real_time_factor": 10.2, "pushes": [{"time": 1.0, "impulse": [8, 0, 0]}],
-         "level_status_counts": [{"optimal": 26000, "infeasible": 0, "iteration_limit": 0, "numerical": 0}],
-         "files": {"csv": "x.csv", "video": "", "plots": []}}
-    s.update(kw)
-    return s
-
-
-def test_table(tmp):
-    d1 = os.path.join(tmp, "runs", "push_x")
-    d2 = os.path.join(tmp, "runs", "push_y")
-    os.makedirs(d1)
-    os.makedirs(d2)
-    with open(os.path.join(d1, "summary.json"), "w") as f:
-        json.dump(summary("push_x", True), f)
-    with open(os.path.join(d2, "summary.json"), "w") as f:
-        json.dump(summary("push_y", False, fall_time=7.25, fall_reason="torso roll", controller="wqp",
-                          max_foot_pitch_deg=None, tick_p999_us=None), f)
-    lst = os.path.join(tmp, "list.json")
-    with open(lst, "w") as f:  # a list of runs, with most keys missing, and a push_sweep record
-        json.dump([{"scenario": "stand", "passed": True},
-                   {"scenario": "push_sweep", "controller": "hqp", "passed": False, "required_impulse": 12.0,
-                    "directions": [{"direction": "+x", "largest_passed": 14.25, "smallest_failed": 15.0},
-                                   {"direction": "-y", "largest_passed": 9.5, "smallest_failed": 10.0}],
-                    "tick_max_us": 900.0, "tick_p999_us_worst_trial": 120.0}], f)
-    md = os.path.join(tmp, "out", "results.md")
-    script = os.path.join(HERE, "summary_table.py")
-    r = run_script([script, os.path.join(tmp, "runs"), lst, "--md", md, "--paper"])
-    check(r.returncode == 0, "summary_table exits 0", r)
-    check(os.path.isfile(md), "summary_table --md writes the file")
-    text = open(md).read() if os.path.isfile(md) else ""
-    check(text == r.stdout, "the file holds the printed table")
-    lines = [ln for ln in text.splitlines() if ln.startswith("|")]
-    check(len(lines) == 2 + 5, f"header, separator and 5 rows ({len(lines)} lines)")
-    rows = {ln.split("|")[1].strip(): [c.strip() for c in ln.split("|")[1:-1]] for ln in lines[2:]}
-    check(rows.get("push_x", [None])[:3] == ["push_x", "hqp", "PASS"], f"push_x row: {rows.get('push_x')}")
-    px = rows.get("push_x", [""] * 9)
-    check(px[3:] == ["12.1°", "-20 … 55 mm", "0.40°", "3.2 mm", "30 / 90 µs", "10.2"], f"push_x figures: {px}")
-    py = rows.get("push_y", [""] * 9)
-    check(py[1] == "wqp" and py[2].startswith("FAIL") and "7.25 s" in py[2] and "torso roll" in py[2],
-          f"push_y fails with its fall: {py[2]}")
-    check(py[5] == "–" and py[7] == "30 / – µs", f"missing values shown as dashes: {py}")
-    st = rows.get("stand", [""] * 9)
-    check(st[2] == "PASS" and st[3] == "–", f"a sparse summary still gives a row: {st}")
-    check(any(k.startswith("paper") for k in rows), "--paper adds the paper's row")
-    sw = rows.get("push_sweep", [""] * 9)
-    check(sw[2] == "FAIL (largest survived, N·s: +x 14.2, -y 9.5)" and sw[7] == "– / 120 µs (worst run)",
-          f"push_sweep row: {sw}")
-
-    # --wide: QP status counts in the simulator's spelling (toString of QpStatus) are summed.
-    with open(os.path.join(tmp, "wide.json"), "w") as f:
-        json.dump(summary("push_x", False, fell=False, zmp_inside=False, lowest_level_error_max=1234.5,
-                          tick_max_us=950.0,
-                          level_status_counts=[{"Optimal": 9, "Infeasible": 1, "IterationLimit": 2,
-                                                "NumericalFailure": 0},
-                                               {"Optimal": 12, "Infeasible": 0, "IterationLimit": 0,
-                                                "NumericalFailure": 3}]), f)
-    r = run_script([script, os.path.join(tmp, "wide.json"), "--wide"])
-    wl = [ln for ln in r.stdout.splitlines() if ln.startswith("| push_x")]
-    cells = [c.strip() for c in wl[0].split("|")[1:-1]] if wl else []
-    check(cells[2:3] == ["FAIL (ZMP left a sole)"] and cells[9:] == ["0.5°", "1.23e+03", "6", "950 µs"],
-          f"--wide row: {cells}", r)
-    r = run_script([script, os.path.join(tmp, "runs"), "--strict"])
-    check(r.returncode == 1, "--strict exits 1 when a run failed", r)
-    r = run_script([script, os.path.join(tmp, "nope.json")])
-    check(r.returncode == 2 and "nope.json" in r.stderr, "a missing summary is a clear error (exit 2)", r)
-
-
 def main():
     with tempfile.TemporaryDirectory(prefix="hqp_plots_") as tmp:
         test_plots(tmp)
-        test_table(tmp)
     if FAILURES:
         print(f"{len(FAILURES)} check(s) failed")
         return 1
