@@ -152,7 +152,18 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
     if (log) log->row(sim, s, push, us, driver.safeMode());
     if (video && sim.time() + 1e-9 >= next_frame) {
       const auto v0 = std::chrono::steady_clock::now();
-      video->frame(sim.data());
+      // Name the latest push for 0.6 s: a force push is invisible otherwise.
+      std::string caption;
+      for (const Push& p : o.pushes) {
+        if (sim.time() >= p.time && sim.time() < p.time + 0.6) {
+          char c[96];
+          std::snprintf(c, sizeof(c), "push %.1f Ns %s%s", p.impulse.norm(),
+                        p.impulse.x() != 0 && p.impulse.y() != 0 ? "" : (p.impulse.x() + p.impulse.y() > 0 ? "+" : "-"),
+                        p.impulse.y() == 0 ? "X" : p.impulse.x() == 0 ? "Y" : "(XY)");
+          caption = c;
+        }
+      }
+      video->frame(sim.data(), caption);
       video_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - v0).count();
       next_frame += 1.0 / o.video_fps;
     }

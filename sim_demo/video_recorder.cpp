@@ -83,13 +83,14 @@ VideoRecorder::~VideoRecorder() {
   eglTerminate(dpy);
 }
 
-void VideoRecorder::frame(mjData* d) {
+void VideoRecorder::frame(mjData* d, const std::string& caption) {
   const mjrRect viewport{0, 0, width_, height_};
   mjv_updateScene(m_, d, &option_, nullptr, &camera_, mjCAT_ALL, &scene_);
   mjr_render(viewport, &scene_, &context_mj_);
   char label[64];
   std::snprintf(label, sizeof(label), "t = %.2f s", d->time);
   mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, viewport, label, nullptr, &context_mj_);
+  if (!caption.empty()) mjr_overlay(mjFONT_BIG, mjGRID_TOPRIGHT, viewport, caption.c_str(), nullptr, &context_mj_);
   mjr_readPixels(rgb_.data(), nullptr, viewport, &context_mj_);
   // OpenGL rows run bottom-up; ffmpeg's vflip turns them the right way.
   if (std::fwrite(rgb_.data(), 1, rgb_.size(), pipe_) != rgb_.size()) throw std::runtime_error("ffmpeg pipe closed");

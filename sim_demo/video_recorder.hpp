@@ -20,7 +20,8 @@ class VideoRecorder {
   VideoRecorder(const VideoRecorder&) = delete;
   VideoRecorder& operator=(const VideoRecorder&) = delete;
 
-  void frame(mjData* d);  // render the current state and append it
+  // Render the current state, with the time and an optional caption (the latest push), and append it.
+  void frame(mjData* d, const std::string& caption = {});
   int frames() const { return frames_; }
   double fps() const { return fps_; }
 
