@@ -33,15 +33,16 @@ std::string fmtOr(const nlohmann::json& j, const char* f, const char* missing = 
   return j.is_number() ? fmt(f, j.get<double>()) : std::string(missing);
 }
 
+// What every record starts with: the scenario, its controller and its verdict.
+nlohmann::json recordHeader(const ScenarioParams& p, bool passed) {
+  return {{"scenario", p.name}, {"description", p.description}, {"controller", p.controller}, {"passed", passed}};
+}
+
 }  // namespace
 
 nlohmann::json runRecord(const ScenarioParams& p, const RunSummary& r) {
-  nlohmann::json j;
-  j["scenario"] = p.name;
-  j["description"] = p.description;
-  j["controller"] = p.controller;
+  nlohmann::json j = recordHeader(p, r.passed);
   j["driver"] = r.driver;
-  j["passed"] = r.passed;
   j["fell"] = r.fell;
   j["fall_time"] = r.fell ? nlohmann::json(r.fall_time) : nlohmann::json(nullptr);
   j["fall_reason"] = r.fall_reason;
@@ -102,11 +103,7 @@ nlohmann::json runRecord(const ScenarioParams& p, const RunSummary& r) {
 }
 
 nlohmann::json sweepRecord(const ScenarioParams& p, const SweepResult& s) {
-  nlohmann::json j;
-  j["scenario"] = p.name;
-  j["description"] = p.description;
-  j["controller"] = p.controller;
-  j["passed"] = s.passed;
+  nlohmann::json j = recordHeader(p, s.passed);
   j["required_impulse"] = p.sweep_params.required;
   j["wall_time_s"] = s.wall_time;
   nlohmann::json dirs = nlohmann::json::array();
