@@ -15,10 +15,10 @@ constexpr double kDeg = 180.0 / M_PI;
 constexpr const char* kFoot[kContacts] = {"left", "right"};
 
 // NaN/inf become null (JSON has no NaN).
-nlohmann::json num(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
+nlohmann::ordered_json num(double x) { return std::isfinite(x) ? nlohmann::ordered_json(x) : nlohmann::ordered_json(nullptr); }
 
-nlohmann::json parametersJson(const ScenarioParams& p) {
-  nlohmann::json j = nlohmann::json::object();
+nlohmann::ordered_json parametersJson(const ScenarioParams& p) {
+  nlohmann::ordered_json j = nlohmann::ordered_json::object();
   for (const auto& [k, v] : parameterValues(p)) j[k] = v;
   return j;
 }
@@ -29,22 +29,22 @@ std::string fmt(const char* f, double x) {
   return b;
 }
 
-std::string fmtOr(const nlohmann::json& j, const char* f, const char* missing = "–") {
+std::string fmtOr(const nlohmann::ordered_json& j, const char* f, const char* missing = "–") {
   return j.is_number() ? fmt(f, j.get<double>()) : std::string(missing);
 }
 
 // What every record starts with: the scenario, its controller and its verdict.
-nlohmann::json recordHeader(const ScenarioParams& p, bool passed) {
+nlohmann::ordered_json recordHeader(const ScenarioParams& p, bool passed) {
   return {{"scenario", p.name}, {"description", p.description}, {"controller", p.controller}, {"passed", passed}};
 }
 
 }  // namespace
 
-nlohmann::json runRecord(const ScenarioParams& p, const RunSummary& r) {
-  nlohmann::json j = recordHeader(p, r.passed);
+nlohmann::ordered_json runRecord(const ScenarioParams& p, const RunSummary& r) {
+  nlohmann::ordered_json j = recordHeader(p, r.passed);
   j["driver"] = r.driver;
   j["fell"] = r.fell;
-  j["fall_time"] = r.fell ? nlohmann::json(r.fall_time) : nlohmann::json(nullptr);
+  j["fall_time"] = r.fell ? nlohmann::ordered_json(r.fall_time) : nlohmann::ordered_json(nullptr);
   j["fall_reason"] = r.fall_reason;
   j["duration_s"] = r.duration;
   j["max_torso_pitch_deg"] = r.max_abs_pitch * kDeg;
@@ -61,7 +61,7 @@ nlohmann::json runRecord(const ScenarioParams& p, const RunSummary& r) {
     if (std::isfinite(r.zmp_margin[c])) margin = std::min(margin, r.zmp_margin[c]);
   }
   j["zmp_margin_mm"] = num(margin * 1e3);
-  nlohmann::json feet = nlohmann::json::array();
+  nlohmann::ordered_json feet = nlohmann::ordered_json::array();
   for (int c = 0; c < kContacts; ++c) {
     feet.push_back({{"foot", kFoot[c]},
                     {"max_pitch_deg", r.max_abs_foot_pitch[c] * kDeg},
@@ -75,9 +75,9 @@ nlohmann::json runRecord(const ScenarioParams& p, const RunSummary& r) {
   j["feet"] = feet;
   j["lowest_level_error_max"] = r.lowest_level_error_max;
   j["lowest_level_error_mean"] = r.lowest_level_error_mean;
-  nlohmann::json levels = nlohmann::json::array();
+  nlohmann::ordered_json levels = nlohmann::ordered_json::array();
   for (int l = 0; l < r.num_levels; ++l) {
-    nlohmann::json c;
+    nlohmann::ordered_json c;
     for (int s = 0; s < 4; ++s) c[toString(static_cast<QpStatus>(s))] = r.level_status_counts[l][s];
     levels.push_back(c);
   }
@@ -89,7 +89,7 @@ nlohmann::json runRecord(const ScenarioParams& p, const RunSummary& r) {
   j["tick_p999_us"] = r.tick_p999_us;
   j["real_time_factor"] = r.real_time_factor;
   j["wall_time_s"] = r.wall_time;
-  nlohmann::json pushes = nlohmann::json::array();
+  nlohmann::ordered_json pushes = nlohmann::ordered_json::array();
   for (const Push& push : runOptions(p).pushes) {
     pushes.push_back({{"time", push.time},
                       {"impulse", {push.impulse.x(), push.impulse.y(), push.impulse.z()}},
@@ -98,18 +98,18 @@ nlohmann::json runRecord(const ScenarioParams& p, const RunSummary& r) {
   j["pushes"] = pushes;
   j["ball_impulse_delivered"] = {r.ball_impulse.x(), r.ball_impulse.y(), r.ball_impulse.z()};
   j["parameters"] = parametersJson(p);
-  j["files"] = {{"csv", r.csv_path}, {"video", r.video_path}, {"plots", nlohmann::json::array()}};
+  j["files"] = {{"csv", r.csv_path}, {"video", r.video_path}, {"plots", nlohmann::ordered_json::array()}};
   return j;
 }
 
-nlohmann::json sweepRecord(const ScenarioParams& p, const SweepResult& s) {
-  nlohmann::json j = recordHeader(p, s.passed);
+nlohmann::ordered_json sweepRecord(const ScenarioParams& p, const SweepResult& s) {
+  nlohmann::ordered_json j = recordHeader(p, s.passed);
   j["required_impulse"] = p.sweep_params.required;
   j["wall_time_s"] = s.wall_time;
-  nlohmann::json dirs = nlohmann::json::array();
+  nlohmann::ordered_json dirs = nlohmann::ordered_json::array();
   double tick_max = 0, tick_p999 = 0;
   for (const SweepDirection& d : s.directions) {
-    nlohmann::json trials = nlohmann::json::array();
+    nlohmann::ordered_json trials = nlohmann::ordered_json::array();
     for (const SweepTrial& t : d.trials) {
       trials.push_back({{"impulse", t.impulse},
                         {"passed", t.run.passed},
@@ -133,7 +133,7 @@ nlohmann::json sweepRecord(const ScenarioParams& p, const SweepResult& s) {
   return j;
 }
 
-void printRecord(std::FILE* out, const nlohmann::json& j) {
+void printRecord(std::FILE* out, const nlohmann::ordered_json& j) {
   const std::string name = j.value("scenario", "?");
   std::fprintf(out, "\n== %s (%s): %s ==\n", name.c_str(), j.value("controller", "").c_str(),
                j.value("passed", false) ? "PASS" : "FAIL");
@@ -202,7 +202,7 @@ void printRecord(std::FILE* out, const nlohmann::json& j) {
   for (const auto& f : j["files"]["plots"]) std::fprintf(out, "  plot               : %s\n", f.get<std::string>().c_str());
 }
 
-std::string markdownTable(const std::vector<nlohmann::json>& records) {
+std::string markdownTable(const std::vector<nlohmann::ordered_json>& records) {
   std::ostringstream s;
   s << "| scenario | controller | result | max torso pitch (°) | max torso roll (°) | CoM x (mm) | "
        "max right-foot pitch (°) | min ZMP margin (mm) | lowest-level error max | tick mean / p99.9 / max (µs) | RTF |\n"
@@ -242,7 +242,7 @@ std::string markdownTable(const std::vector<nlohmann::json>& records) {
   return s.str();
 }
 
-void writeJson(const std::string& path, const nlohmann::json& j) { writeText(path, j.dump(2) + "\n"); }
+void writeJson(const std::string& path, const nlohmann::ordered_json& j) { writeText(path, j.dump(2) + "\n"); }
 
 void writeText(const std::string& path, const std::string& text) {
   std::ofstream f(path);

@@ -14,17 +14,17 @@
 
 namespace hqp::sim {
 
-nlohmann::json runRecord(const ScenarioParams& p, const RunSummary& r);
-nlohmann::json sweepRecord(const ScenarioParams& p, const SweepResult& s);
+nlohmann::ordered_json runRecord(const ScenarioParams& p, const RunSummary& r);
+nlohmann::ordered_json sweepRecord(const ScenarioParams& p, const SweepResult& s);
 
 // Human-readable summary of one record (run or sweep) on `out`.
-void printRecord(std::FILE* out, const nlohmann::json& record);
+void printRecord(std::FILE* out, const nlohmann::ordered_json& record);
 
 // The summary table (markdown) of all records, with the paper's figures beside push_x.
-std::string markdownTable(const std::vector<nlohmann::json>& records);
+std::string markdownTable(const std::vector<nlohmann::ordered_json>& records);
 
 // Writes `path` (pretty JSON) and throws std::runtime_error when it cannot.
-void writeJson(const std::string& path, const nlohmann::json& j);
+void writeJson(const std::string& path, const nlohmann::ordered_json& j);
 void writeText(const std::string& path, const std::string& text);
 
 }  // namespace hqp::sim

@@ -149,7 +149,7 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  std::vector<nlohmann::json> records;
+  std::vector<nlohmann::ordered_json> records;
   bool all_passed = true;
   try {
     fs::create_directories(out);
@@ -167,7 +167,7 @@ int main(int argc, char** argv) {
       std::printf("\n== %s: %s; %s%s ==\n", p.name.c_str(), p.description.c_str(), driver->name(),
                   p.noise ? ", sensor noise on" : "");
       std::fflush(stdout);
-      nlohmann::json record;
+      nlohmann::ordered_json record;
       if (p.sweep) {
         const auto on_trial = [](const hqp::sim::SweepDirection& d, const hqp::sim::SweepTrial& t) {
           std::printf("  %s %6.2f N·s: %s (max pitch %.1f deg, roll %.1f deg)%s%s\n", d.direction.c_str(), t.impulse,
