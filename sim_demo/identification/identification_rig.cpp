@@ -61,7 +61,7 @@ struct Noise {
 // torque is what the plant needed for the motion it made, whatever the model.
 hi::JointLog run(hqp::ident_demo::MujocoRig& rig, const hi::FourierTrajectory& traj, int periods,
                  const Noise& noise, double pd_hz, unsigned seed, const hi::BaseParameters& bp,
-                 const Eigen::VectorXd& beta_ff, double dq_star, double* worst_tracking,
+                 const Eigen::VectorXd& beta_ff, const hm::JointVector<Robot>& dq_star, double* worst_tracking,
                  Eigen::MatrixXd* clean_tau) {
   hm::Data<Robot> d;
   hm::RegressorMatrix<Robot> Y;
@@ -100,7 +100,7 @@ hi::JointLog run(hqp::ident_demo::MujocoRig& rig, const hi::FourierTrajectory& t
     traj.evaluate(t, q, dq, ddq);
     gains(q);
     typename hm::Data<Robot>::VectorV vq = q, vv = dq, va = ddq;
-    hm::computeRegressor<Robot>(d, vq, vv, va, hm::JointVector<Robot>::Constant(dq_star), Y);
+    hm::computeRegressor<Robot>(d, vq, vv, va, dq_star, Y);
     const Eigen::VectorXd qs = rig.q(), dqs = rig.dq();
     Eigen::VectorXd tau = kp.cwiseProduct(q - qs) + kd.cwiseProduct(dq - dqs);
     for (int c = 0; c < bp.rank; ++c) tau += Y.col(bp.independent[static_cast<std::size_t>(c)]) * beta_ff[c];
@@ -260,7 +260,7 @@ hi::FourierTrajectory chooseValidation(unsigned seed, const hi::JointLimits& lim
 // Y_B β for the conditioned samples (N × nj), one sample at a time (a 1 kHz
 // log would make the stacked W_B of predictTorques ~100 MB).
 Eigen::MatrixXd predict(const hi::BaseParameters& bp, const Eigen::VectorXd& beta,
-                        const hi::ConditionedLog& c, double dq_star) {
+                        const hi::ConditionedLog& c, const hm::JointVector<Robot>& dq_star) {
   hm::Data<Robot> d;
   hm::RegressorMatrix<Robot> Y;
   typename hm::Data<Robot>::VectorV q, v, a;
@@ -269,7 +269,7 @@ Eigen::MatrixXd predict(const hi::BaseParameters& bp, const Eigen::VectorXd& bet
     q = c.q.row(k).transpose();
     v = c.dq.row(k).transpose();
     a = c.ddq.row(k).transpose();
-    hm::computeRegressor<Robot>(d, q, v, a, hm::JointVector<Robot>::Constant(dq_star), Y);
+    hm::computeRegressor<Robot>(d, q, v, a, dq_star, Y);
     for (int i = 0; i < bp.rank; ++i) {
       tau.row(k) += beta[i] * Y.col(bp.independent[static_cast<std::size_t>(i)]).transpose();
     }
@@ -285,6 +285,7 @@ struct Settings {
   double val_fill = 0.95;
   int val_candidates = 50;
   int periods = 2;
+  int passes = 2;                  // excitation runs: CAD feedforward, then the identified model
   bool validate_with_cad = false;  // validation feedforward: CAD instead of the identified model
   hi::FitSettings fs;
 };
@@ -330,19 +331,33 @@ SeedResult runSeed(unsigned seed, const Settings& S, const hi::BaseParameters& b
     std::printf("\n");
   }
 
-  // Excitation run: CAD feedforward (nothing identified yet).
+  // Excitation runs. The first has the CAD feedforward (nothing identified
+  // yet): with the URDF's friction far from the plant's, joints stick at
+  // reversals and break away with transients faster than the q low-pass,
+  // which the fit then sees as model error. Each further pass runs the same
+  // excitation again with the previous pass's identified model as
+  // feedforward (smooth tracking) and is fitted on its own.
   const Eigen::VectorXd beta_cad_ff = bp.K * hm::nominalParameters<Robot>();
   double track_fit = 0.0, track_val = 0.0;
   Eigen::MatrixXd fit_clean, val_clean;
-  const hi::JointLog fit_log = run(rig, excitation, S.periods, S.noise, S.pd_hz, seed + 1, bp,
-                                   beta_cad_ff, fs.dq_star, &track_fit, &fit_clean);
-  const hi::ConditionedLog c = hi::conditionLog(fit_log, fs);
-  const hi::FitResult fit = hi::fitBaseParameters<Robot>(bp, c, fs);
+  hi::JointLog fit_log;
+  hi::FitResult fit;
+  for (int pass = 0; pass < std::max(1, S.passes); ++pass) {
+    fit_log = run(rig, excitation, S.periods, S.noise, S.pd_hz, seed + 1 + 100 * pass, bp,
+                  pass == 0 ? beta_cad_ff : fit.ls.beta,
+                  pass == 0 ? hi::dqStar<Robot>(fs) : hi::dqStar<Robot>(fit), &track_fit, &fit_clean);
+    fit = hi::fitBaseParameters<Robot>(bp, hi::conditionLog(fit_log, fs), fs);
+    if (verbose) {
+      std::printf("excitation pass %d (%s feedforward): worst tracking error %.3f rad\n", pass + 1,
+                  pass == 0 ? "CAD" : "identified", track_fit);
+    }
+  }
 
   // Validation run: the identified model as feedforward (eq. 7 friction at the
   // desired velocity with the identified F_c, F_v), as the controller uses it.
   const hi::JointLog val_log = run(rig, validation, 1, S.noise, S.pd_hz, seed + 2, bp,
-                                   S.validate_with_cad ? beta_cad_ff : fit.ls.beta, fs.dq_star,
+                                   S.validate_with_cad ? beta_cad_ff : fit.ls.beta,
+                                   S.validate_with_cad ? hi::dqStar<Robot>(fs) : hi::dqStar<Robot>(fit),
                                    &track_val, &val_clean);
   SeedResult R;
   if (verbose) {
@@ -366,8 +381,8 @@ SeedResult runSeed(unsigned seed, const Settings& S, const hi::BaseParameters& b
   // CAD = the paper's "3D model": URDF inertias, no friction.
   hm::ParameterVector<Robot> cad = hm::nominalParameters<Robot>();
   cad.tail<hm::RegressorSizes<Robot>::n_friction>().setZero();
-  const Eigen::MatrixXd ident = predict(bp, fit.ls.beta, v, fs.dq_star);
-  const Eigen::MatrixXd cadp = predict(bp, bp.K * cad, v, fs.dq_star);
+  const Eigen::MatrixXd ident = predict(bp, fit.ls.beta, v, hi::dqStar<Robot>(fit));
+  const Eigen::MatrixXd cadp = predict(bp, bp.K * cad, v, hi::dqStar<Robot>(fs));
   const hi::ButterworthLowPass band(fs.filter_order, fs.cutoff_hz, 1.0 / val_log.dt());
   const auto rms = [](const Eigen::VectorXd& e) { return std::sqrt(e.squaredNorm() / e.size()); };
 
@@ -375,7 +390,7 @@ SeedResult runSeed(unsigned seed, const Settings& S, const hi::BaseParameters& b
     JointResult r;
     // The plant's viscous law counts from 0, eq. 7's from the band edge q̇*:
     // F_c(eq. 7) = F_c + F_v q̇* for the same torques outside the band.
-    r.c_true = rig.truth().coulomb[j] + rig.truth().viscous[j] * fs.dq_star;
+    r.c_true = rig.truth().coulomb[j] + rig.truth().viscous[j] * fit.friction[static_cast<std::size_t>(j)].dq_star;
     r.v_true = rig.truth().viscous[j];
     r.c_id = fit.friction[j].coulomb;
     r.v_id = fit.friction[j].viscous;
@@ -407,12 +422,13 @@ SeedResult runSeed(unsigned seed, const Settings& S, const hi::BaseParameters& b
   }
 
   if (verbose) {
-    std::printf("\nfriction           Coulomb (N m)          viscous (N m s/rad)\n");
-    std::printf("joint              true    ident   err    true    ident   err\n");
+    std::printf("\nfriction           Coulomb, eq. 7 (N m)   viscous (N m s/rad)     q̇* (rad/s)\n");
+    std::printf("joint              true    ident   err    true    ident   err     ident\n");
     for (int j = 0; j < Robot::nj; ++j) {
       const JointResult& r = R.joints[static_cast<std::size_t>(j)];
-      std::printf("%-16s %7.3f %7.3f %6.3f  %6.3f %7.3f %6.3f\n", joints[j].c_str(), r.c_true, r.c_id,
-                  r.c_id - r.c_true, r.v_true, r.v_id, r.v_id - r.v_true);
+      std::printf("%-16s %7.3f %7.3f %6.3f  %6.3f %7.3f %6.3f   %7.4f\n", joints[j].c_str(), r.c_true,
+                  r.c_id, r.c_id - r.c_true, r.v_true, r.v_id, r.v_id - r.v_true,
+                  fit.friction[static_cast<std::size_t>(j)].dq_star);
     }
     std::printf("\nvalidation torque RMS error (N m), all %ld samples at 1 kHz (0.5 s trimmed at each end)\n",
                 static_cast<long>(v.time.size()));
@@ -452,6 +468,8 @@ int main(int argc, char** argv) {
   int evaluations = 3000;
   bool require_target = false;
   S.fs.min_speed = 0.05;
+  S.fs.fit_dq_star = true;
+  S.fs.average_torque = true;
   app.add_option("--urdf", S.urdf, "Walker3 URDF")->capture_default_str();
   app.add_option("--out-dir", out_dir, "where the logs, YAML and torques of the first seed go")
       ->capture_default_str();
@@ -459,6 +477,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--max-evals", evaluations, "excitation optimizer budget")->capture_default_str();
   app.add_option("--periods", S.periods, "excitation periods run on the rig")->capture_default_str();
+  app.add_option("--passes", S.passes,
+                 "excitation runs: the first with CAD feedforward, each next one with the "
+                 "previous fit as feedforward; the last is fitted")->capture_default_str();
   app.add_option("--q-noise", S.noise.q, "encoder noise std (rad)")->capture_default_str();
   app.add_option("--tau-noise", S.noise.tau, "torque noise std (N m)")->capture_default_str();
   app.add_option("--pd-hz", S.pd_hz, "PD bandwidth (Hz) from the CAD joint inertia")->capture_default_str();
@@ -473,6 +494,13 @@ int main(int argc, char** argv) {
   app.add_option("--validation-candidates", S.val_candidates,
                  "validation: random trajectories drawn, the one moving most is run")
       ->capture_default_str();
+  app.add_option("--fit-dq-star", S.fs.fit_dq_star,
+                 "estimate q̇* of eq. 7 per joint from the slow samples (else --dq-star for all)")
+      ->capture_default_str();
+  app.add_option("--average-torque", S.fs.average_torque,
+                 "fit: each decimated row's torque is the mean over its decimation window")
+      ->capture_default_str();
+  app.add_option("--dq-star", S.fs.dq_star, "q̇* of eq. 7 (rad/s) when not estimated")->capture_default_str();
   app.add_flag("--validate-with-cad-feedforward", S.validate_with_cad,
                "validation run with the CAD feedforward instead of the identified model");
   app.add_flag("--require-target", require_target,
