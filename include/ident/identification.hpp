@@ -251,15 +251,17 @@ FitResult fitBaseParameters(const BaseParameters& bp, const ConditionedLog& c,
                             const FitSettings& s) {
   using Sizes = model::RegressorSizes<Robot>;
   const model::JointVector<Robot> dq_star = dqStar<Robot>(s);
-  const Eigen::MatrixXd W = stackBaseRegressor<Robot>(bp, c.q, c.dq, c.ddq, dq_star);
   FitResult r;
-  std::vector<bool> use;
-  if (s.min_speed > 0.0) {
-    for (Eigen::Index k = 0; k < c.dq.rows(); ++k) {
-      for (int j = 0; j < Robot::nj; ++j) use.push_back(std::abs(c.dq(k, j)) >= s.min_speed);
+  {
+    const Eigen::MatrixXd W = stackBaseRegressor<Robot>(bp, c.q, c.dq, c.ddq, dq_star);
+    std::vector<bool> use;
+    if (s.min_speed > 0.0) {
+      for (Eigen::Index k = 0; k < c.dq.rows(); ++k) {
+        for (int j = 0; j < Robot::nj; ++j) use.push_back(std::abs(c.dq(k, j)) >= s.min_speed);
+      }
     }
+    r.ls = solveLeastSquares(W, stackTorques(c.tau), Robot::nj, s.weighted, use);
   }
-  r.ls = solveLeastSquares(W, stackTorques(c.tau), Robot::nj, s.weighted, use);
   const std::vector<std::string> names = parameterNames<Robot>();
   const std::vector<std::string> joints = jointNames<Robot>();
   for (int k = 0; k < bp.rank; ++k) {
