@@ -82,7 +82,7 @@ def main():
         ax.plot(t, measured, color="tab:red", linestyle=":", linewidth=0.8, alpha=0.7, label="measured")
         ax.plot(t, ident, color="tab:blue", linewidth=1.3, label="identified (base parameters)")
         ax.plot(t, cad, color="black", linestyle="--", linewidth=1.0, label="CAD model (URDF, no friction)")
-        ax.set_title(f"{j}   RMS error: identified {rms(ident - measured):.2f} N·m, "
+        ax.set_title(f"{j}   RMS error vs measured: identified {rms(ident - measured):.2f} N·m, "
                      f"CAD {rms(cad - measured):.2f} N·m", fontsize=9)
         ax.set_ylabel("torque (N·m)")
         ax.grid(True, alpha=0.3)
