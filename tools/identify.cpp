@@ -183,8 +183,10 @@ int main(int argc, char** argv) {
   app.add_option("--filter-order", fs.filter_order, "Butterworth order")->capture_default_str();
   app.add_option("--decimation", fs.decimation, "use every n-th sample")->capture_default_str();
   app.add_flag("--filter-torque", fs.filter_torque, "low-pass the torque too");
-  app.add_flag("--average-torque", fs.average_torque,
-               "each decimated row's torque is the mean over its decimation window (less noise)");
+  fs.average_torque = true;
+  app.add_flag("--average-torque,!--no-average-torque", fs.average_torque,
+               "each decimated row's torque is the mean over its decimation window (less noise; "
+               "default on)");
   app.add_flag("--fit-dq-star", fs.fit_dq_star,
                "estimate q̇* of eq. 7 per joint from the samples slower than --min-speed "
                "(with --controller-yaml, its dq_star values are replaced too)");
