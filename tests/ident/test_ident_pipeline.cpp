@@ -499,6 +499,13 @@ TEST(ParametersYaml, UpdatesTheControllerConfiguration) {
   EXPECT_EQ(warnings.size(), 1u);
   EXPECT_EQ(root["safe_mode"]["joints"]["l_knee"]["coulomb"].as<double>(), 9.0);  // other block untouched
   EXPECT_NE(out.find("# ratio 100"), std::string::npos);  // comments kept
+  // dq_star is kept unless asked for (an estimated q̇*, --fit-dq-star).
+  EXPECT_EQ(root["joint_control"]["joints"]["l_knee"]["dq_star"].as<double>(), 0.05);
+  const YAML::Node with_dq = YAML::Load(hi::controllerYamlWithFriction(
+      text, {{"l_knee", 4.25, 1.5, 0.0125}, {"r_hip_yaw", 1.125, 0.5, 0.03}}, nullptr, true));
+  EXPECT_EQ(with_dq["joint_control"]["joints"]["l_knee"]["dq_star"].as<double>(), 0.0125);
+  EXPECT_EQ(with_dq["joint_control"]["joints"]["r_hip_yaw"]["dq_star"].as<double>(), 0.03);
+  EXPECT_EQ(with_dq["joint_control"]["joints"]["l_knee"]["k_f"].as<double>(), 0.8);
   EXPECT_THROW(hi::controllerYamlWithFriction(text, {{"l_ankle_roll", 1, 1, 0.05}}), std::runtime_error);
   EXPECT_THROW(hi::controllerYamlDqStar("controller:\n  dt: 1\n", joints), std::runtime_error);
 #ifdef HQP_CONTROLLER_YAML
