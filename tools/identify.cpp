@@ -183,6 +183,13 @@ int main(int argc, char** argv) {
   app.add_option("--filter-order", fs.filter_order, "Butterworth order")->capture_default_str();
   app.add_option("--decimation", fs.decimation, "use every n-th sample")->capture_default_str();
   app.add_flag("--filter-torque", fs.filter_torque, "low-pass the torque too");
+  fs.average_torque = true;
+  app.add_flag("--average-torque,!--no-average-torque", fs.average_torque,
+               "each decimated row's torque is the mean over its decimation window (less noise; "
+               "default on)");
+  app.add_flag("--fit-dq-star", fs.fit_dq_star,
+               "estimate q̇* of eq. 7 per joint from the samples slower than --min-speed "
+               "(with --controller-yaml, its dq_star values are replaced too)");
   app.add_flag("--unweighted", unweighted, "ordinary instead of weighted least squares");
   CLI11_PARSE(app, argc, argv);
   fs.weighted = !unweighted;
@@ -225,10 +232,10 @@ int main(int argc, char** argv) {
     const hi::FitResult fit = hi::fitBaseParameters<Robot>(bp, c, fs);
     std::printf("fit: %ld samples used, condition number %.1f\n", static_cast<long>(c.q.rows()),
                 fit.ls.condition);
-    std::printf("%-16s %10s %10s %12s\n", "joint", "coulomb", "viscous", "residual RMS");
+    std::printf("%-16s %10s %10s %10s %12s\n", "joint", "coulomb", "viscous", "dq_star", "residual RMS");
     for (int j = 0; j < Robot::nj; ++j) {
-      std::printf("%-16s %10.4f %10.4f %12.4f\n", fit.friction[j].joint.c_str(), fit.friction[j].coulomb,
-                  fit.friction[j].viscous, fit.ls.joint_rms[j]);
+      std::printf("%-16s %10.4f %10.4f %10.4f %12.4f\n", fit.friction[j].joint.c_str(), fit.friction[j].coulomb,
+                  fit.friction[j].viscous, fit.friction[j].dq_star, fit.ls.joint_rms[j]);
     }
     std::ofstream out(yaml_out);
     if (!out) throw std::runtime_error(yaml_out + ": cannot write");
@@ -238,14 +245,14 @@ int main(int argc, char** argv) {
                               fit.friction, fit.base);
     } else {
       std::vector<std::string> warnings;
-      out << hi::controllerYamlWithFriction(controller_text, fit.friction, &warnings);
+      out << hi::controllerYamlWithFriction(controller_text, fit.friction, &warnings, fs.fit_dq_star);
       for (const std::string& w : warnings) std::printf("warning: %s\n", w.c_str());
     }
     std::printf("wrote %s\n", yaml_out.c_str());
 
     const hi::ConditionedLog v = validate_log.empty() ? c : hi::conditionLog(readLog(validate_log), fs);
     const Eigen::MatrixXd ident =
-        hi::predictTorques<Robot>(bp, fit.ls.beta, v.q, v.dq, v.ddq, hi::dqStar<Robot>(fs));
+        hi::predictTorques<Robot>(bp, fit.ls.beta, v.q, v.dq, v.ddq, hi::dqStar<Robot>(fit));
     const Eigen::MatrixXd cad = cadTorques(v, hi::dqStar<Robot>(fs));
     std::printf("%s torque error per joint (N m): %-9s %-9s | %-9s %-9s\n",
                 validate_log.empty() ? "fit-log" : "validation", "CAD rms", "CAD max", "ID rms", "ID max");

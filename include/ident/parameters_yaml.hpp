@@ -157,19 +157,23 @@ inline std::vector<double> controllerYamlDqStar(const std::string& text,
   return dq_star;
 }
 
-// The controller YAML with `coulomb` and `viscous` replaced by the identified
-// values (negative estimates, which the controller rejects, become 0 and are
-// reported in `warnings`). Every identified joint must be present.
+// The controller YAML with `coulomb` and `viscous` (and `dq_star` too with
+// `with_dq_star`, when q̇* was estimated) replaced by the identified values
+// (negative estimates, which the controller rejects, become 0 and are reported
+// in `warnings`). Every identified joint must be present.
 inline std::string controllerYamlWithFriction(const std::string& text,
                                               const std::vector<IdentifiedFriction>& friction,
-                                              std::vector<std::string>* warnings = nullptr) {
+                                              std::vector<std::string>* warnings = nullptr,
+                                              bool with_dq_star = false) {
   std::vector<std::string> lines = detail::splitLines(text);
   std::vector<bool> done(friction.size(), false);
   detail::forEachControllerJoint(lines, [&](std::string& line, const std::string& name) {
     for (std::size_t j = 0; j < friction.size(); ++j) {
       if (friction[j].joint != name) continue;
-      for (const char* field : {"coulomb", "viscous"}) {
-        double x = std::string(field) == "coulomb" ? friction[j].coulomb : friction[j].viscous;
+      for (const char* field : {"coulomb", "viscous", "dq_star"}) {
+        const std::string f(field);
+        if (f == "dq_star" && !with_dq_star) continue;
+        double x = f == "coulomb" ? friction[j].coulomb : (f == "viscous" ? friction[j].viscous : friction[j].dq_star);
         if (x < 0.0) {
           if (warnings) warnings->push_back(name + "." + field + " identified as " + detail::yamlNumber(x) + ", written as 0");
           x = 0.0;

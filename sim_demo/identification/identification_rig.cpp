@@ -3,23 +3,31 @@
 // its torso, masses ±15 %, CoMs moved, Coulomb friction 1–5 N·m and viscous
 // friction 0.2–2 N·m·s/rad that the identification never sees.
 //
-//  1. base parameters and the optimized Fourier excitation (NLopt COBYLA);
-//  2. the plant tracks it for two periods under joint PD control at 1 kHz,
-//     with CAD inverse dynamics and the URDF's nominal friction (eq. 7 at the
-//     desired velocity) as feedforward; q and the motor torque are logged
-//     with sensor noise;
-//  3. the log is filtered, differentiated and fitted (weighted LS);
-//  4. a different trajectory validates: torque prediction error per joint,
-//     CAD (URDF inertias, no friction: "the 3D model" of the paper) vs identified,
-//     RMS over all samples of the run (stuck ones included). The validation
+//  1. base parameters and the optimized Fourier excitation (NLopt COBYLA), once;
+//  then per plant seed (--seeds):
+//  2. the plant tracks the excitation for two periods under joint PD control at
+//     1 kHz with the CAD model (URDF inertias and friction, eq. 7 at the desired
+//     velocity) as feedforward; q and the motor torque are logged with sensor
+//     noise; the log is filtered, differentiated and fitted (weighted LS, q̇* of
+//     eq. 7 per joint, torque averaged over each decimation window);
+//  3. the excitation is run again with the identified model as feedforward and
+//     fitted again (--passes);
+//  4. a different trajectory validates, tracked with the identified model as
+//     feedforward: torque prediction error per joint, CAD (URDF inertias, no
+//     friction: "the 3D model" of the paper) vs identified, RMS over every 1 kHz
+//     sample of the run (stuck ones included; 0.5 s trimmed at each end),
+//     against the applied torque, the measured torque, and the measured torque
+//     with the error band-limited to the fit's low-pass. The validation
 //     trajectory is a random Fourier series per joint, scaled to the URDF
 //     limits and chosen, from the reference alone, to keep every joint moving.
-// Writes the logs (hqp_identify's CSV format), the identified YAML and the
-// validation torques for a plot like the paper's Fig. 7 into --out-dir.
-// Prints on how many joints the issue's target (validation RMS below 1 N·m and
-// 5× below CAD) is met. Exit code 0 when, on every joint, the friction is
-// recovered (F_c within 0.25 N·m, F_v within 0.5 N·m·s/rad), the identified model
-// is better than CAD and below 1 N·m RMS on the samples where the joint moves (|q̇| ≥ --min-speed: eq. 7 does not model a stuck joint); 1 otherwise.
+// Writes, for the first seed, the logs (hqp_identify's CSV format), the
+// identified YAML and the validation torques (tools/plot_identification.py
+// draws Fig. 7 from them) into --out-dir, and a table over the seeds.
+// Exit code 0 when, on every joint of every seed, the friction is recovered
+// (F_c within 0.25 N·m, F_v within 0.5 N·m·s/rad), the identified model is better
+// than CAD and below 1 N·m RMS where the joint moves; with --require-target, the
+// issue's target (validation RMS < 1 N·m and ≥ 5× below CAD, against the applied
+// and the band-limited measured torque) must hold on every joint too. 1 otherwise.
 
 #include <CLI/CLI.hpp>
 
@@ -28,6 +36,7 @@
 #include <cstdio>
 #include <fstream>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -51,15 +60,20 @@ struct Noise {
   double tau = 0.3;   // torque (current) noise (N·m)
 };
 
-// PD + CAD feedforward at 1 kHz along `traj` for `periods` periods; returns the log.
+// PD + model feedforward at 1 kHz along `traj` for `periods` periods; returns
+// the log. The feedforward is the base-parameter model Y_B(q_d, q̇_d, q̈_d) β_ff
+// at the desired state, its friction columns being eq. 7 at the desired
+// velocity (the paper's joint controller, eqs. 5 and 7): for the excitation run
+// β_ff = K π_CAD (URDF inertias and the URDF's nominal friction); for the
+// validation run β_ff = the identified β (the model is in use once identified).
+// The feedforward only decides which states the plant visits: the logged
+// torque is what the plant needed for the motion it made, whatever the model.
 hi::JointLog run(hqp::ident_demo::MujocoRig& rig, const hi::FourierTrajectory& traj, int periods,
-                 const Noise& noise, double pd_hz, unsigned seed, double* worst_tracking,
+                 const Noise& noise, double pd_hz, unsigned seed, const hi::BaseParameters& bp,
+                 const Eigen::VectorXd& beta_ff, const hm::JointVector<Robot>& dq_star, double* worst_tracking,
                  Eigen::MatrixXd* clean_tau) {
   hm::Data<Robot> d;
   hm::RegressorMatrix<Robot> Y;
-  // Feedforward: CAD inverse dynamics plus the URDF's nominal friction by eq. 7
-  // at the desired velocity (the paper's joint controller, eqs. 5 and 7).
-  const hm::ParameterVector<Robot> cad = hm::nominalParameters<Robot>();
   Eigen::VectorXd q(Robot::nj), dq(Robot::nj), ddq(Robot::nj);
   traj.evaluate(0.0, q, dq, ddq);
   // Gains from the CAD joint-space inertia along the reference, every tick:
@@ -95,10 +109,10 @@ hi::JointLog run(hqp::ident_demo::MujocoRig& rig, const hi::FourierTrajectory& t
     traj.evaluate(t, q, dq, ddq);
     gains(q);
     typename hm::Data<Robot>::VectorV vq = q, vv = dq, va = ddq;
-    hm::computeRegressor<Robot>(d, vq, vv, va, hm::JointVector<Robot>::Constant(0.01), Y);
+    hm::computeRegressor<Robot>(d, vq, vv, va, dq_star, Y);
     const Eigen::VectorXd qs = rig.q(), dqs = rig.dq();
-    const Eigen::VectorXd tau =
-        Y * cad + kp.cwiseProduct(q - qs) + kd.cwiseProduct(dq - dqs);
+    Eigen::VectorXd tau = kp.cwiseProduct(q - qs) + kd.cwiseProduct(dq - dqs);
+    for (int c = 0; c < bp.rank; ++c) tau += Y.col(bp.independent[static_cast<std::size_t>(c)]) * beta_ff[c];
     *worst_tracking = std::max(*worst_tracking, (q - qs).cwiseAbs().maxCoeff());
     log.time[k] = t;
     clean_tau->row(k) = tau.transpose();
@@ -109,43 +123,6 @@ hi::JointLog run(hqp::ident_demo::MujocoRig& rig, const hi::FourierTrajectory& t
     rig.step(tau);
   }
   return log;
-}
-
-// A plot like the paper's Fig. 7 as SVG (no plotting library needed): one panel
-// per joint of the left leg, measured torque (red), identified (blue), CAD (black).
-void writeFig7Svg(const std::string& path, const Eigen::VectorXd& t, const Eigen::MatrixXd& measured,
-                  const Eigen::MatrixXd& ident, const Eigen::MatrixXd& cad,
-                  const std::vector<std::string>& joints) {
-  std::ofstream out(path);
-  const int W = 900, H = 180, pad = 50;
-  const int panels = std::min<int>(6, static_cast<int>(joints.size()));
-  out << "<svg xmlns='http://www.w3.org/2000/svg' width='" << W << "' height='" << H * panels + 30
-      << "' font-family='sans-serif' font-size='12'>\n<rect width='100%' height='100%' fill='white'/>\n"
-      << "<text x='" << pad << "' y='18'>validation torques, left leg: measured (red), identified "
-      << "(blue), CAD (black dashed)</text>\n";
-  const double t0 = t[0], t1 = t[t.size() - 1];
-  for (int j = 0; j < panels; ++j) {
-    const double y0 = 30 + j * H;
-    double lo = std::min({measured.col(j).minCoeff(), ident.col(j).minCoeff(), cad.col(j).minCoeff()});
-    double hi = std::max({measured.col(j).maxCoeff(), ident.col(j).maxCoeff(), cad.col(j).maxCoeff()});
-    if (hi - lo < 1e-9) hi = lo + 1.0;
-    const auto X = [&](double x) { return pad + (W - 2 * pad) * (x - t0) / (t1 - t0); };
-    const auto Y = [&](double y) { return y0 + 10 + (H - 40) * (hi - y) / (hi - lo); };
-    out << "<rect x='" << pad << "' y='" << y0 + 10 << "' width='" << W - 2 * pad << "' height='"
-        << H - 40 << "' fill='none' stroke='#999'/>\n";
-    out << "<text x='" << pad + 5 << "' y='" << y0 + 24 << "'>" << joints[static_cast<std::size_t>(j)]
-        << " (N m)</text>\n<text x='5' y='" << Y(hi) + 4 << "'>" << std::lround(hi)
-        << "</text>\n<text x='5' y='" << Y(lo) + 4 << "'>" << std::lround(lo) << "</text>\n";
-    const auto line = [&](const Eigen::MatrixXd& m, const char* style) {
-      out << "<polyline fill='none' " << style << " points='";
-      for (Eigen::Index k = 0; k < t.size(); ++k) out << X(t[k]) << "," << Y(m(k, j)) << " ";
-      out << "'/>\n";
-    };
-    line(measured, "stroke='#d33' stroke-width='1'");
-    line(ident, "stroke='#23c' stroke-width='1.2'");
-    line(cad, "stroke='black' stroke-width='1' stroke-dasharray='4 3'");
-  }
-  out << "<text x='" << W / 2 << "' y='" << H * panels + 25 << "'>time (s)</text>\n</svg>\n";
 }
 
 // Scales each joint's motion about q0 (linear in its coefficients, rest at the
@@ -200,8 +177,14 @@ Eigen::VectorXd stuckShare(const hi::FourierTrajectory& traj, const Eigen::Vecto
   return share;
 }
 
-void writeLog(const std::string& path, const hi::JointLog& log) {
+std::ofstream openOut(const std::string& path) {
   std::ofstream out(path);
+  if (!out) throw std::runtime_error(path + ": cannot write (does --out-dir exist?)");
+  return out;
+}
+
+void writeLog(const std::string& path, const hi::JointLog& log) {
+  std::ofstream out = openOut(path);
   out << "time";
   for (const std::string& j : log.joints) out << ",q_" << j;
   for (const std::string& j : log.joints) out << ",tau_" << j;
@@ -220,50 +203,328 @@ void writeLog(const std::string& path, const hi::JointLog& log) {
   }
 }
 
-}  // namespace
 
-int main(int argc, char** argv) {
-  CLI::App app{"Identification of Walker3 on a MuJoCo rig (paper §V-B), with a validation report."};
-  std::string urdf = HQP_WALKER3_URDF, out_dir = ".";
-  unsigned seed = 42;
-  int evaluations = 3000, periods = 2;
+// The a-priori breakaway tracking error of each joint: what the PD needs beyond
+// the feedforward's URDF friction to reach the top of the rig's Coulomb range
+// (5 N m), (5 − F_urdf) / k_p, with k_p from the CAD inertia at mid-range (the
+// gains of run()). Never the plant's friction.
+Eigen::VectorXd breakawayError(const hi::JointLimits& limits, double pd_hz) {
+  hm::Data<Robot> d;
+  typename hm::Data<Robot>::VectorQ qm;
+  for (int j = 0; j < Robot::nj; ++j) qm[j] = 0.5 * (limits.q_min[j] + limits.q_max[j]);
+  hm::crba<Robot>(d, qm);
+  const Eigen::MatrixXd Minv = Eigen::MatrixXd(d.M).inverse();
+  const double wn = 2.0 * 3.14159265358979 * pd_hz;
+  Eigen::VectorXd e(Robot::nj);
+  for (int j = 0; j < Robot::nj; ++j) {
+    const double f_urdf = Robot::bodies[static_cast<std::size_t>(j)].friction;
+    e[j] = std::max(0.005, (5.0 - f_urdf) * Minv(j, j) / (wn * wn));
+  }
+  return e;
+}
+
+// Validation: a different Fourier trajectory (same harmonics and period), not
+// optimized for conditioning but for motion. Per joint, of `candidates` random
+// draws (coefficients ~ N(0, l^p), p cycling through −1…2; every second draw
+// without the first harmonic), each scaled and centred to the joint's tightest
+// URDF limit, the one with the least estimated stuck time (stuckShare) is kept.
+// Uses the reference and a-priori figures only, never the rig's response.
+hi::FourierTrajectory chooseValidation(unsigned seed, const hi::JointLimits& limits,
+                                       const hi::FourierSettings& fourier, const Eigen::VectorXd& e_break,
+                                       int candidates, double fill) {
+  hi::FourierTrajectory validation(Robot::nj, fourier);
+  const int L = fourier.harmonics, per = hi::FourierTrajectory::freePerJoint(fourier);
+  Eigen::VectorXd best_x(validation.numFree());
+  Eigen::VectorXd best = Eigen::VectorXd::Constant(Robot::nj, 2.0);
+  for (int c = 0; c < candidates; ++c) {
+    std::mt19937 rng(1000 + seed + static_cast<unsigned>(c));
+    std::normal_distribution<double> normal(0.0, 1.0);
+    const double p = -1.0 + (c / 2) % 4;
+    Eigen::VectorXd x(validation.numFree());
+    for (int j = 0; j < Robot::nj; ++j) {
+      Eigen::VectorXd a(L - 1), b(L - 1), l(L - 1);
+      for (int i = 0; i < L - 1; ++i) {
+        l[i] = i + 2;
+        a[i] = std::pow(l[i], p) * normal(rng);
+        b[i] = std::pow(l[i], p) * normal(rng);
+      }
+      if (c % 2 == 1) {
+        // Σ a_l = 0 and Σ l b_l = 0: the rest conditions leave the first harmonic at zero.
+        a.array() -= a.mean();
+        b -= (l.dot(b) / l.squaredNorm()) * l;
+      }
+      x[j * per] = 0.5 * (limits.q_min[j] + limits.q_max[j]);
+      x.segment(j * per + 1, L - 1) = a;
+      x.segment(j * per + L, L - 1) = b;
+    }
+    hi::FourierTrajectory cand(Robot::nj, fourier);
+    cand.setFree(x);
+    scaleToLimits(cand, limits, fill);
+    const Eigen::VectorXd stuck = stuckShare(cand, e_break);
+    for (int j = 0; j < Robot::nj; ++j) {
+      if (stuck[j] < best[j]) {
+        best[j] = stuck[j];
+        best_x.segment(j * per, per) = cand.free().segment(j * per, per);
+      }
+    }
+  }
+  validation.setFree(best_x);
+  return validation;
+}
+
+// Y_B β for the conditioned samples (N × nj), one sample at a time (a 1 kHz
+// log would make the stacked W_B of predictTorques ~100 MB).
+Eigen::MatrixXd predict(const hi::BaseParameters& bp, const Eigen::VectorXd& beta,
+                        const hi::ConditionedLog& c, const hm::JointVector<Robot>& dq_star) {
+  hm::Data<Robot> d;
+  hm::RegressorMatrix<Robot> Y;
+  typename hm::Data<Robot>::VectorV q, v, a;
+  Eigen::MatrixXd tau = Eigen::MatrixXd::Zero(c.q.rows(), Robot::nj);
+  for (Eigen::Index k = 0; k < c.q.rows(); ++k) {
+    q = c.q.row(k).transpose();
+    v = c.dq.row(k).transpose();
+    a = c.ddq.row(k).transpose();
+    hm::computeRegressor<Robot>(d, q, v, a, dq_star, Y);
+    for (int i = 0; i < bp.rank; ++i) {
+      tau.row(k) += beta[i] * Y.col(bp.independent[static_cast<std::size_t>(i)]).transpose();
+    }
+  }
+  return tau;
+}
+
+struct Settings {
+  std::string urdf = HQP_WALKER3_URDF;
   Noise noise;
   double pd_hz = 20.0;
   double friction_timeconst = 0.004;
   double val_fill = 0.95;
   int val_candidates = 50;
+  int periods = 2;
+  int passes = 2;                  // excitation runs: CAD feedforward, then the identified model
+  bool validate_with_cad = false;  // validation feedforward: CAD instead of the identified model
   hi::FitSettings fs;
-  fs.min_speed = 0.05;
-  app.add_option("--urdf", urdf, "Walker3 URDF")->capture_default_str();
-  app.add_option("--out-dir", out_dir, "where the logs, YAML and torques go")->capture_default_str();
-  app.add_option("--seed", seed, "seed of the plant's true parameters")->capture_default_str();
-  app.add_option("--max-evals", evaluations, "excitation optimizer budget")->capture_default_str();
-  app.add_option("--periods", periods, "excitation periods run on the rig")->capture_default_str();
-  app.add_option("--q-noise", noise.q, "encoder noise std (rad)")->capture_default_str();
-  app.add_option("--tau-noise", noise.tau, "torque noise std (N m)")->capture_default_str();
-  app.add_option("--pd-hz", pd_hz, "PD bandwidth (Hz) from the CAD joint inertia")->capture_default_str();
-  app.add_option("--cutoff", fs.cutoff_hz, "low-pass cutoff for q (Hz)")->capture_default_str();
-  app.add_option("--min-speed", fs.min_speed, "rows slower than this are left out (rad/s)")
-      ->capture_default_str();
-  app.add_option("--friction-timeconst", friction_timeconst,
-                 "time constant of MuJoCo's frictionloss constraint (s)")->capture_default_str();
-  app.add_option("--validation-fill", val_fill,
-                 "validation: scale each joint to this fraction of its tightest limit")
-      ->capture_default_str();
-  app.add_option("--validation-candidates", val_candidates,
-                 "validation: random trajectories drawn, the one moving most is run")
-      ->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
+};
 
+// Validation figures of one joint (N m). "applied": against the torque the
+// motor applied (simulation only, no sensor noise); "meas": against the
+// measured torque; "band": against the measured torque, the error low-passed by
+// the fit's zero-phase filter (what a real rig can check: the model's inputs
+// are band-limited to the same cutoff, the sensor noise is not).
+struct JointResult {
+  double c_true = 0, c_id = 0, v_true = 0, v_id = 0;
+  double cad_applied = 0, id_applied = 0, id_applied_max = 0, cad_meas = 0, id_meas = 0,
+         cad_band = 0, id_band = 0, id_moving = 0, moving_share = 0;
+};
+bool targetMet(double cad, double id) { return id < 1.0 && cad >= 5.0 * id; }
+
+struct SeedResult {
+  std::vector<JointResult> joints;
+  int met_applied = 0, met_band = 0, met_meas = 0;
+  bool ok = true;  // friction recovered, better than CAD, < 1 N m RMS while moving
+};
+
+SeedResult runSeed(unsigned seed, const Settings& S, const hi::BaseParameters& bp,
+                   const hi::FourierTrajectory& excitation, const hi::JointLimits& limits,
+                   const std::string& out_dir, bool verbose) {
+  const hi::FitSettings& fs = S.fs;
   std::vector<std::string> links;
   for (const hm::BodyDesc& b : Robot::bodies) links.emplace_back(b.name);
   const std::vector<std::string> joints = hi::jointNames<Robot>();
-  hqp::ident_demo::MujocoRig rig(urdf, links, joints);
-  rig.friction_timeconst = friction_timeconst;
+  hqp::ident_demo::MujocoRig rig(S.urdf, links, joints);
+  rig.friction_timeconst = S.friction_timeconst;
   rig.perturb(seed);
 
+  const Eigen::VectorXd e_break = breakawayError(limits, S.pd_hz);
+  const hi::FourierTrajectory validation =
+      chooseValidation(seed, limits, excitation.settings(), e_break, S.val_candidates, S.val_fill);
+  if (verbose) {
+    const Eigen::VectorXd stuck_val = stuckShare(validation, e_break);
+    std::printf("validation: breakaway error (rad)\n ");
+    for (int j = 0; j < Robot::nj; ++j) std::printf(" %s %.3f", joints[j].c_str(), e_break[j]);
+    std::printf("\nvalidation: estimated stuck share of the reference (within the breakaway error of a turning point)\n ");
+    for (int j = 0; j < Robot::nj; ++j) std::printf(" %s %.0f %%", joints[j].c_str(), 100 * stuck_val[j]);
+    std::printf("\n");
+  }
+
+  // Excitation runs. The first has the CAD feedforward (nothing identified
+  // yet): with the URDF's friction far from the plant's, joints stick at
+  // reversals and break away with transients faster than the q low-pass,
+  // which the fit then sees as model error. Each further pass runs the same
+  // excitation again with the previous pass's identified model as
+  // feedforward (smooth tracking) and is fitted on its own.
+  const Eigen::VectorXd beta_cad_ff = bp.K * hm::nominalParameters<Robot>();
+  double track_fit = 0.0, track_val = 0.0;
+  Eigen::MatrixXd fit_clean, val_clean;
+  hi::JointLog fit_log;
+  hi::FitResult fit;
+  for (int pass = 0; pass < std::max(1, S.passes); ++pass) {
+    fit_log = run(rig, excitation, S.periods, S.noise, S.pd_hz, seed + 1 + 100 * pass, bp,
+                  pass == 0 ? beta_cad_ff : fit.ls.beta,
+                  pass == 0 ? hi::dqStar<Robot>(fs) : hi::dqStar<Robot>(fit), &track_fit, &fit_clean);
+    fit = hi::fitBaseParameters<Robot>(bp, hi::conditionLog(fit_log, fs), fs);
+    if (verbose) {
+      std::printf("excitation pass %d (%s feedforward): worst tracking error %.3f rad\n", pass + 1,
+                  pass == 0 ? "CAD" : "identified", track_fit);
+    }
+  }
+
+  // Validation run: the identified model as feedforward (eq. 7 friction at the
+  // desired velocity with the identified F_c, F_v), as the controller uses it.
+  const hi::JointLog val_log = run(rig, validation, 1, S.noise, S.pd_hz, seed + 2, bp,
+                                   S.validate_with_cad ? beta_cad_ff : fit.ls.beta,
+                                   S.validate_with_cad ? hi::dqStar<Robot>(fs) : hi::dqStar<Robot>(fit),
+                                   &track_val, &val_clean);
+  SeedResult R;
+  if (verbose) {
+    std::printf("rig: %d + 1 periods at 1 kHz, worst tracking error %.3f / %.3f rad\n", S.periods,
+                track_fit, track_val);
+  }
+  if (!(track_fit < 0.5) || !(track_val < 0.5)) {
+    std::printf("FAIL (seed %u): the rig did not track (unstable PD? lower --pd-hz)\n", seed);
+    R.ok = false;
+    return R;
+  }
+
+  // Validation samples: every 1 kHz sample but the 0.5 s trimmed at each end
+  // (filter and difference edges), stuck ones included.
+  hi::FitSettings vs = fs;
+  vs.decimation = 1;
+  const hi::ConditionedLog v = hi::conditionLog(val_log, vs);
+  hi::JointLog val_clean_log = val_log;
+  val_clean_log.tau = val_clean;
+  const hi::ConditionedLog vc = hi::conditionLog(val_clean_log, vs);
+  // CAD = the paper's "3D model": URDF inertias, no friction.
+  hm::ParameterVector<Robot> cad = hm::nominalParameters<Robot>();
+  cad.tail<hm::RegressorSizes<Robot>::n_friction>().setZero();
+  const Eigen::MatrixXd ident = predict(bp, fit.ls.beta, v, hi::dqStar<Robot>(fit));
+  const Eigen::MatrixXd cadp = predict(bp, bp.K * cad, v, hi::dqStar<Robot>(fs));
+  const hi::ButterworthLowPass band(fs.filter_order, fs.cutoff_hz, 1.0 / val_log.dt());
+  const auto rms = [](const Eigen::VectorXd& e) { return std::sqrt(e.squaredNorm() / e.size()); };
+
+  for (int j = 0; j < Robot::nj; ++j) {
+    JointResult r;
+    // The plant's viscous law counts from 0, eq. 7's from the band edge q̇*:
+    // F_c(eq. 7) = F_c + F_v q̇* for the same torques outside the band.
+    r.c_true = rig.truth().coulomb[j] + rig.truth().viscous[j] * fit.friction[static_cast<std::size_t>(j)].dq_star;
+    r.v_true = rig.truth().viscous[j];
+    r.c_id = fit.friction[j].coulomb;
+    r.v_id = fit.friction[j].viscous;
+    const Eigen::VectorXd ec = cadp.col(j) - v.tau.col(j), ei = ident.col(j) - v.tau.col(j);
+    const Eigen::VectorXd ec0 = cadp.col(j) - vc.tau.col(j), ei0 = ident.col(j) - vc.tau.col(j);
+    r.cad_applied = rms(ec0);
+    r.id_applied = rms(ei0);
+    r.id_applied_max = ei0.cwiseAbs().maxCoeff();
+    r.cad_meas = rms(ec);
+    r.id_meas = rms(ei);
+    r.cad_band = rms(band.filtfilt(ec));
+    r.id_band = rms(band.filtfilt(ei));
+    // Samples where the joint moves (|q̇| ≥ min_speed): outside stiction (for insight).
+    double ss = 0.0;
+    int n_moving = 0;
+    for (Eigen::Index k = 0; k < ei0.size(); ++k) {
+      if (std::abs(v.dq(k, j)) < fs.min_speed) continue;
+      ss += ei0[k] * ei0[k];
+      ++n_moving;
+    }
+    r.id_moving = std::sqrt(ss / std::max(1, n_moving));
+    r.moving_share = static_cast<double>(n_moving) / static_cast<double>(ei0.size());
+    R.met_applied += targetMet(r.cad_applied, r.id_applied) ? 1 : 0;
+    R.met_band += targetMet(r.cad_band, r.id_band) ? 1 : 0;
+    R.met_meas += targetMet(r.cad_meas, r.id_meas) ? 1 : 0;
+    R.ok = R.ok && std::abs(r.c_id - r.c_true) < 0.25 && std::abs(r.v_id - r.v_true) < 0.5 &&
+           r.cad_applied > r.id_applied && r.id_moving < 1.0;
+    R.joints.push_back(r);
+  }
+
+  if (verbose) {
+    std::printf("\nfriction           Coulomb, eq. 7 (N m)   viscous (N m s/rad)     q̇* (rad/s)\n");
+    std::printf("joint              true    ident   err    true    ident   err     ident\n");
+    for (int j = 0; j < Robot::nj; ++j) {
+      const JointResult& r = R.joints[static_cast<std::size_t>(j)];
+      std::printf("%-16s %7.3f %7.3f %6.3f  %6.3f %7.3f %6.3f   %7.4f\n", joints[j].c_str(), r.c_true,
+                  r.c_id, r.c_id - r.c_true, r.v_true, r.v_id, r.v_id - r.v_true,
+                  fit.friction[static_cast<std::size_t>(j)].dq_star);
+    }
+    std::printf("\nvalidation torque RMS error (N m), all %ld samples at 1 kHz (0.5 s trimmed at each end)\n",
+                static_cast<long>(v.time.size()));
+    std::printf("                  vs applied (noise-free)         | vs measured, 0-%.0f Hz band | vs measured raw"
+                "       | ID while moving\n", fs.cutoff_hz);
+    std::printf("joint             CAD     ID   ID max  ratio      |  CAD     ID   ratio        |  CAD     ID   ratio"
+                " | rms   (share)\n");
+    for (int j = 0; j < Robot::nj; ++j) {
+      const JointResult& r = R.joints[static_cast<std::size_t>(j)];
+      std::printf("%-16s %5.2f %6.3f %6.2f %6.1f %-4s | %5.2f %6.3f %6.1f %-4s | %5.2f %6.3f %6.1f | %5.3f (%3.0f %%)\n",
+                  joints[j].c_str(), r.cad_applied, r.id_applied, r.id_applied_max,
+                  r.cad_applied / r.id_applied, targetMet(r.cad_applied, r.id_applied) ? "" : "MISS",
+                  r.cad_band, r.id_band, r.cad_band / r.id_band,
+                  targetMet(r.cad_band, r.id_band) ? "" : "MISS", r.cad_meas, r.id_meas,
+                  r.cad_meas / r.id_meas, r.id_moving, 100.0 * r.moving_share);
+    }
+  }
+  if (!out_dir.empty()) {
+    writeLog(out_dir + "/rig_excitation_log.csv", fit_log);
+    writeLog(out_dir + "/rig_validation_log.csv", val_log);
+    std::ofstream y = openOut(out_dir + "/rig_identified.yaml");
+    hi::writeParametersYaml(y, "identified on the MuJoCo rig (hqp_identification_rig)", fit.friction,
+                            fit.base);
+    std::ofstream p = openOut(out_dir + "/rig_validation_torques.csv");
+    hi::writeTorquePrediction(p, v.time, joints, v.tau, ident, cadp);
+  }
+  return R;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Identification of Walker3 on a MuJoCo rig (paper §V-B), with a validation report."};
+  Settings S;
+  std::string out_dir = ".";
+  std::vector<unsigned> seeds{42};
+  int evaluations = 3000;
+  bool require_target = false;
+  S.fs.min_speed = 0.05;
+  S.fs.fit_dq_star = true;
+  S.fs.average_torque = true;
+  app.add_option("--urdf", S.urdf, "Walker3 URDF")->capture_default_str();
+  app.add_option("--out-dir", out_dir, "where the logs, YAML and torques of the first seed go")
+      ->capture_default_str();
+  app.add_option("--seed,--seeds", seeds, "seeds of the plant's true parameters (one run each)")
+      ->capture_default_str();
+  app.add_option("--max-evals", evaluations, "excitation optimizer budget")->capture_default_str();
+  app.add_option("--periods", S.periods, "excitation periods run on the rig")->capture_default_str();
+  app.add_option("--passes", S.passes,
+                 "excitation runs: the first with CAD feedforward, each next one with the "
+                 "previous fit as feedforward; the last is fitted")->capture_default_str();
+  app.add_option("--q-noise", S.noise.q, "encoder noise std (rad)")->capture_default_str();
+  app.add_option("--tau-noise", S.noise.tau, "torque noise std (N m)")->capture_default_str();
+  app.add_option("--pd-hz", S.pd_hz, "PD bandwidth (Hz) from the CAD joint inertia")->capture_default_str();
+  app.add_option("--cutoff", S.fs.cutoff_hz, "low-pass cutoff for q (Hz)")->capture_default_str();
+  app.add_option("--min-speed", S.fs.min_speed, "rows slower than this are left out of the fit (rad/s)")
+      ->capture_default_str();
+  app.add_option("--friction-timeconst", S.friction_timeconst,
+                 "time constant of MuJoCo's frictionloss constraint (s)")->capture_default_str();
+  app.add_option("--validation-fill", S.val_fill,
+                 "validation: scale each joint to this fraction of its tightest limit")
+      ->capture_default_str();
+  app.add_option("--validation-candidates", S.val_candidates,
+                 "validation: random trajectories drawn, the one moving most is run")
+      ->capture_default_str();
+  app.add_option("--fit-dq-star", S.fs.fit_dq_star,
+                 "estimate q̇* of eq. 7 per joint from the slow samples (else --dq-star for all)")
+      ->capture_default_str();
+  app.add_option("--average-torque", S.fs.average_torque,
+                 "fit: each decimated row's torque is the mean over its decimation window")
+      ->capture_default_str();
+  app.add_option("--dq-star", S.fs.dq_star, "q̇* of eq. 7 (rad/s) when not estimated")->capture_default_str();
+  app.add_flag("--validate-with-cad-feedforward", S.validate_with_cad,
+               "validation run with the CAD feedforward instead of the identified model");
+  app.add_flag("--require-target", require_target,
+               "exit 1 unless the issue's target is met on every joint of every seed, against "
+               "the applied torque and against the band-limited measured torque");
+  CLI11_PARSE(app, argc, argv);
+
   const hi::BaseParameters bp =
-      hi::computeBaseParameters<Robot>(hm::JointVector<Robot>::Constant(fs.dq_star));
+      hi::computeBaseParameters<Robot>(hm::JointVector<Robot>::Constant(S.fs.dq_star));
   hi::ExcitationSettings es;
   es.max_evaluations = evaluations;
   const hi::JointLimits limits = hi::jointLimitsFromModel<Robot>(10.0);
@@ -272,160 +533,60 @@ int main(int argc, char** argv) {
   std::printf("base parameters: %d of %d\n", bp.rank, hm::RegressorSizes<Robot>::np);
   std::printf("excitation: condition number %.1f -> %.1f (%d evaluations)\n", ex.cond_initial,
               ex.cond_final, ex.evaluations);
-  // Validation: a different Fourier trajectory (same 5 harmonics and period),
-  // not optimized for conditioning but for motion. Per joint, of
-  // `val_candidates` random draws (coefficients ~ N(0, l^p), p cycling through
-  // −1…2; every second draw without the first harmonic), each scaled and
-  // centred to the joint's tightest URDF limit, the one with the least
-  // estimated stuck time (stuckShare) is kept. The breakaway tracking error of
-  // a joint is what the PD needs beyond the feedforward's URDF friction to
-  // reach the top of the rig's Coulomb range (5 N m): (5 − F_urdf) / k_p, with
-  // k_p from the CAD inertia at mid-range (the gains of run()). A priori
-  // figures only, not the plant's friction.
-  hi::FourierTrajectory validation(Robot::nj, es.fourier);
-  Eigen::VectorXd e_break(Robot::nj);
-  {
-    hm::Data<Robot> d;
-    typename hm::Data<Robot>::VectorQ qm;
-    for (int j = 0; j < Robot::nj; ++j) qm[j] = 0.5 * (limits.q_min[j] + limits.q_max[j]);
-    hm::crba<Robot>(d, qm);
-    const Eigen::MatrixXd Minv = Eigen::MatrixXd(d.M).inverse();
-    const double wn = 2.0 * 3.14159265358979 * pd_hz;
+
+  const std::vector<std::string> joints = hi::jointNames<Robot>();
+  std::vector<SeedResult> results;
+  bool ok = true, target = true;
+  for (std::size_t i = 0; i < seeds.size(); ++i) {
+    std::printf("\n=== plant seed %u ===\n", seeds[i]);
+    try {
+      results.push_back(runSeed(seeds[i], S, bp, excitation, limits, i == 0 ? out_dir : std::string(), true));
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "hqp_identification_rig: %s\n", e.what());
+      return 2;
+    }
+    const SeedResult& R = results.back();
+    ok = ok && R.ok;
+    target = target && R.met_applied == Robot::nj && R.met_band == Robot::nj;
+    std::printf("seed %u: issue target (RMS < 1 N m and >= 5x below CAD) met on %d of %d joints vs the "
+                "applied torque, %d vs the band-limited measured torque (%d vs the raw measured torque)\n",
+                seeds[i], R.met_applied, Robot::nj, R.met_band, R.met_meas);
+  }
+  // One line per seed: the worst joint by the CAD/ID ratio, both references.
+  std::printf("\n seed | target met (applied / band / raw) | worst ratio applied (joint, ID RMS) | "
+              "worst ratio band (joint, ID RMS) | max ID RMS applied | max |F_c err| | max |F_v err|\n");
+  for (std::size_t i = 0; i < seeds.size(); ++i) {
+    const SeedResult& R = results[i];
+    if (R.joints.empty()) {
+      std::printf(" %4u | did not track\n", seeds[i]);
+      continue;
+    }
+    int wa = 0, wb = 0;
+    double max_id = 0.0, fc = 0.0, fv = 0.0;
     for (int j = 0; j < Robot::nj; ++j) {
-      const double f_urdf = Robot::bodies[static_cast<std::size_t>(j)].friction;
-      e_break[j] = std::max(0.005, (5.0 - f_urdf) * Minv(j, j) / (wn * wn));
+      const JointResult& r = R.joints[static_cast<std::size_t>(j)];
+      const JointResult& a = R.joints[static_cast<std::size_t>(wa)];
+      const JointResult& b = R.joints[static_cast<std::size_t>(wb)];
+      if (r.cad_applied / r.id_applied < a.cad_applied / a.id_applied) wa = j;
+      if (r.cad_band / r.id_band < b.cad_band / b.id_band) wb = j;
+      max_id = std::max(max_id, r.id_applied);
+      fc = std::max(fc, std::abs(r.c_id - r.c_true));
+      fv = std::max(fv, std::abs(r.v_id - r.v_true));
     }
-  }
-  {
-    const int L = es.fourier.harmonics, per = hi::FourierTrajectory::freePerJoint(es.fourier);
-    Eigen::VectorXd best_x(validation.numFree());
-    Eigen::VectorXd best = Eigen::VectorXd::Constant(Robot::nj, 2.0);
-    for (int c = 0; c < val_candidates; ++c) {
-      std::mt19937 rng(1000 + seed + static_cast<unsigned>(c));
-      std::normal_distribution<double> normal(0.0, 1.0);
-      const double p = -1.0 + (c / 2) % 4;
-      Eigen::VectorXd x(validation.numFree());
-      for (int j = 0; j < Robot::nj; ++j) {
-        Eigen::VectorXd a(L - 1), b(L - 1), l(L - 1);
-        for (int i = 0; i < L - 1; ++i) {
-          l[i] = i + 2;
-          a[i] = std::pow(l[i], p) * normal(rng);
-          b[i] = std::pow(l[i], p) * normal(rng);
-        }
-        if (c % 2 == 1) {
-          // Σ a_l = 0 and Σ l b_l = 0: the rest conditions leave the first harmonic at zero.
-          a.array() -= a.mean();
-          b -= (l.dot(b) / l.squaredNorm()) * l;
-        }
-        x[j * per] = 0.5 * (limits.q_min[j] + limits.q_max[j]);
-        x.segment(j * per + 1, L - 1) = a;
-        x.segment(j * per + L, L - 1) = b;
-      }
-      hi::FourierTrajectory cand(Robot::nj, es.fourier);
-      cand.setFree(x);
-      scaleToLimits(cand, limits, val_fill);
-      const Eigen::VectorXd stuck = stuckShare(cand, e_break);
-      for (int j = 0; j < Robot::nj; ++j) {
-        if (stuck[j] < best[j]) {
-          best[j] = stuck[j];
-          best_x.segment(j * per, per) = cand.free().segment(j * per, per);
-        }
-      }
-    }
-    validation.setFree(best_x);
-  }
-  const Eigen::VectorXd stuck_val = stuckShare(validation, e_break);
-  std::printf("validation: breakaway error (rad)\n ");
-  for (int j = 0; j < Robot::nj; ++j) std::printf(" %s %.3f", joints[j].c_str(), e_break[j]);
-  std::printf("\nvalidation: estimated stuck share of the reference (within the breakaway error of a turning point)\n ");
-  for (int j = 0; j < Robot::nj; ++j) std::printf(" %s %.0f %%", joints[j].c_str(), 100 * stuck_val[j]);
-  std::printf("\n");
-
-  double track_fit = 0.0, track_val = 0.0;
-  Eigen::MatrixXd fit_clean, val_clean;
-  const hi::JointLog fit_log = run(rig, excitation, periods, noise, pd_hz, seed + 1, &track_fit, &fit_clean);
-  const hi::JointLog val_log = run(rig, validation, 1, noise, pd_hz, seed + 2, &track_val, &val_clean);
-  std::printf("rig: %d + 1 periods at 1 kHz, worst tracking error %.3f / %.3f rad\n", periods,
-              track_fit, track_val);
-  if (!(track_fit < 0.5) || !(track_val < 0.5)) {
-    std::printf("FAIL: the rig did not track (unstable PD? lower --pd-hz)\n");
-    return 1;
-  }
-  writeLog(out_dir + "/rig_excitation_log.csv", fit_log);
-  writeLog(out_dir + "/rig_validation_log.csv", val_log);
-
-  const hi::ConditionedLog c = hi::conditionLog(fit_log, fs);
-  const hi::FitResult fit = hi::fitBaseParameters<Robot>(bp, c, fs);
-  std::printf("\nfriction           Coulomb (N m)          viscous (N m s/rad)\n");
-  std::printf("joint              true    ident   err    true    ident   err\n");
-  for (int j = 0; j < Robot::nj; ++j) {
-    // The plant's viscous law counts from 0, eq. 7's from the band edge q̇*:
-    // F_c(eq. 7) = F_c + F_v q̇* for the same torques outside the band.
-    const double c_true = rig.truth().coulomb[j] + rig.truth().viscous[j] * fs.dq_star;
-    std::printf("%-16s %7.3f %7.3f %6.3f  %6.3f %7.3f %6.3f\n", joints[j].c_str(), c_true,
-                fit.friction[j].coulomb, fit.friction[j].coulomb - c_true, rig.truth().viscous[j],
-                fit.friction[j].viscous, fit.friction[j].viscous - rig.truth().viscous[j]);
-  }
-  {
-    std::ofstream y(out_dir + "/rig_identified.yaml");
-    hi::writeParametersYaml(y, "identified on the MuJoCo rig (hqp_identification_rig)", fit.friction,
-                            fit.base);
-  }
-
-  // Validation: CAD and identified predictions against the measured (noisy)
-  // torque and against the applied torque before the sensor noise.
-  const hi::ConditionedLog v = hi::conditionLog(val_log, fs);
-  hi::JointLog val_clean_log = val_log;
-  val_clean_log.tau = val_clean;
-  const hi::ConditionedLog vc = hi::conditionLog(val_clean_log, fs);
-  const Eigen::MatrixXd ident = hi::predictTorques<Robot>(bp, fit.ls.beta, v.q, v.dq, v.ddq, fs.dq_star);
-  hm::ParameterVector<Robot> cad = hm::nominalParameters<Robot>();
-  cad.tail<hm::RegressorSizes<Robot>::n_friction>().setZero();
-  const Eigen::VectorXd beta_cad = bp.K * cad;
-  const Eigen::MatrixXd cadp = hi::predictTorques<Robot>(bp, beta_cad, v.q, v.dq, v.ddq, fs.dq_star);
-  const auto rms = [](const Eigen::VectorXd& e) { return std::sqrt(e.squaredNorm() / e.size()); };
-  std::printf("\nvalidation torque error (N m)   vs measured (noise %.2f)        |  vs applied (noise-free)\n",
-              noise.tau);
-  std::printf("joint             CAD rms CAD max  ID rms  ID max  ratio | CAD rms  ID rms  ID max  ratio"
-              " | ID rms moving (share)\n");
-  int target_met = 0;
-  bool ok = true;
-  for (int j = 0; j < Robot::nj; ++j) {
-    const Eigen::VectorXd ec = cadp.col(j) - v.tau.col(j);
-    const Eigen::VectorXd ei = ident.col(j) - v.tau.col(j);
-    const Eigen::VectorXd ec0 = cadp.col(j) - vc.tau.col(j);
-    const Eigen::VectorXd ei0 = ident.col(j) - vc.tau.col(j);
-    // Samples where the joint moves (|q̇| ≥ min_speed): outside stiction.
-    double ss = 0.0;
-    int n_moving = 0;
-    for (Eigen::Index k = 0; k < ei0.size(); ++k) {
-      if (std::abs(v.dq(k, j)) < fs.min_speed) continue;
-      ss += ei0[k] * ei0[k];
-      ++n_moving;
-    }
-    const double moving = std::sqrt(ss / std::max(1, n_moving));
-    const bool target = rms(ei0) < 1.0 && rms(ec0) >= 5.0 * rms(ei0);
-    target_met += target ? 1 : 0;
-    // CI criterion: friction recovered, the identified model better than CAD
-    // everywhere and below 1 N m wherever eq. 7 applies (the joint moves).
-    const double c_true = rig.truth().coulomb[j] + rig.truth().viscous[j] * fs.dq_star;
-    ok = ok && std::abs(fit.friction[j].coulomb - c_true) < 0.25 &&
-         std::abs(fit.friction[j].viscous - rig.truth().viscous[j]) < 0.5 &&
-         rms(ec0) > rms(ei0) && moving < 1.0;
-    std::printf("%-16s %7.3f %7.3f %7.3f %7.3f %6.1f | %7.3f %7.3f %7.3f %6.1f | %7.3f (%3.0f %%) %s\n",
-                joints[j].c_str(), rms(ec), ec.cwiseAbs().maxCoeff(), rms(ei), ei.cwiseAbs().maxCoeff(),
-                rms(ec) / rms(ei), rms(ec0), rms(ei0), ei0.cwiseAbs().maxCoeff(), rms(ec0) / rms(ei0),
-                moving, 100.0 * n_moving / ei0.size(), target ? "" : "(target missed)");
-  }
-  writeFig7Svg(out_dir + "/rig_fig7.svg", v.time, v.tau, ident, cadp, joints);
-  std::printf("\nissue target (RMS < 1 N m and 5x below CAD, vs applied torque) met on %d of %d joints\n",
-              target_met, Robot::nj);
-  {
-    std::ofstream p(out_dir + "/rig_validation_torques.csv");
-    hi::writeTorquePrediction(p, v.time, joints, v.tau, ident, cadp);
+    const JointResult& a = R.joints[static_cast<std::size_t>(wa)];
+    const JointResult& b = R.joints[static_cast<std::size_t>(wb)];
+    std::printf(" %4u | %2d / %2d / %2d of %d | %5.1f (%s, %.3f) | %5.1f (%s, %.3f) | %.3f | %.3f | %.3f\n",
+                seeds[i], R.met_applied, R.met_band, R.met_meas, Robot::nj,
+                a.cad_applied / a.id_applied, joints[static_cast<std::size_t>(wa)].c_str(), a.id_applied,
+                b.cad_band / b.id_band, joints[static_cast<std::size_t>(wb)].c_str(), b.id_band, max_id,
+                fc, fv);
   }
   std::printf("%s: friction recovered (F_c within 0.25 N m, F_v within 0.5 N m s/rad), identified "
-              "model better than CAD and < 1 N m RMS while moving, on %s joint\n",
-              ok ? "PASS" : "FAIL", ok ? "every" : "not every");
-  return ok ? 0 : 1;
+              "model better than CAD and < 1 N m RMS while moving, on %s joint of %s seed\n",
+              ok ? "PASS" : "FAIL", ok ? "every" : "not every", ok ? "every" : "some");
+  if (require_target) {
+    std::printf("%s: issue target on every joint of every seed (applied and band-limited measured torque)\n",
+                target ? "PASS" : "FAIL");
+  }
+  return ok && (!require_target || target) ? 0 : 1;
 }

@@ -133,6 +133,38 @@ TEST(Filtering, RejectsBadArguments) {
   EXPECT_THROW(hi::centralDifference(Eigen::VectorXd::Zero(2), 0.001), std::invalid_argument);
 }
 
+// Decimation with the torque averaged over the window centred on each kept
+// sample: exact for a linear signal (the symmetric window has no lag), and
+// white noise shrinks by √(window) (closed forms).
+TEST(ConditionLog, AveragesTorqueOverTheDecimationWindow) {
+  const int N = 20000;
+  hi::JointLog log;
+  log.joints = {"a", "b"};
+  log.time.resize(N);
+  log.q = Eigen::MatrixXd::Zero(N, 2);
+  log.tau.resize(N, 2);
+  std::mt19937 rng(5u);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (int k = 0; k < N; ++k) {
+    log.time[k] = 1e-3 * k;
+    log.tau(k, 0) = 2.0 + 3.0 * log.time[k];  // linear
+    log.tau(k, 1) = noise(rng);                // white, σ = 1
+  }
+  hi::FitSettings fs;
+  fs.decimation = 10;  // window of 11 samples
+  fs.average_torque = true;
+  const hi::ConditionedLog c = hi::conditionLog(log, fs);
+  ASSERT_GT(c.time.size(), 1000);
+  for (Eigen::Index i = 0; i < c.time.size(); ++i) {
+    ASSERT_NEAR(c.tau(i, 0), 2.0 + 3.0 * c.time[i], 1e-9) << i;
+  }
+  const double sd = std::sqrt(c.tau.col(1).squaredNorm() / static_cast<double>(c.tau.rows()));
+  EXPECT_NEAR(sd, 1.0 / std::sqrt(11.0), 0.03);
+  fs.average_torque = false;
+  const hi::ConditionedLog raw = hi::conditionLog(log, fs);
+  EXPECT_NEAR(std::sqrt(raw.tau.col(1).squaredNorm() / static_cast<double>(raw.tau.rows())), 1.0, 0.05);
+}
+
 // ---------------------------------------------------------------- least squares
 struct Synthetic {
   hi::ConditionedLog log;
@@ -152,9 +184,9 @@ Eigen::VectorXd randomTruth(std::mt19937& rng) {
   return pi;
 }
 
-// Samples of the trajectory with torques Y π (exact derivatives).
+// Samples of the trajectory with torques Y π (exact derivatives), q̇* per joint.
 Synthetic synthesize(const hi::FourierTrajectory& traj, const Eigen::VectorXd& pi, int N,
-                     double dq_star) {
+                     const hm::JointVector<Robot>& dq_star) {
   Synthetic s;
   s.pi = pi;
   s.log.time.resize(N);
@@ -168,7 +200,7 @@ Synthetic synthesize(const hi::FourierTrajectory& traj, const Eigen::VectorXd& p
   for (int k = 0; k < N; ++k) {
     const double t = traj.period() * k / N;
     traj.evaluate(t, q, dq, ddq);
-    hm::computeRegressor<Robot>(d, q, dq, ddq, hm::JointVector<Robot>::Constant(dq_star), Y);
+    hm::computeRegressor<Robot>(d, q, dq, ddq, dq_star, Y);
     s.log.time[k] = t;
     s.log.q.row(k) = q.transpose();
     s.log.dq.row(k) = dq.transpose();
@@ -176,6 +208,10 @@ Synthetic synthesize(const hi::FourierTrajectory& traj, const Eigen::VectorXd& p
     s.log.tau.row(k) = (Y * pi).transpose();
   }
   return s;
+}
+Synthetic synthesize(const hi::FourierTrajectory& traj, const Eigen::VectorXd& pi, int N,
+                     double dq_star) {
+  return synthesize(traj, pi, N, hm::JointVector<Robot>::Constant(dq_star));
 }
 
 class LeastSquares : public ::testing::Test {
@@ -226,6 +262,33 @@ TEST_F(LeastSquares, ExactFromNoiseFreeTorques) {
       }
     }
   }
+}
+
+// q̇* of eq. 7 per joint from the slow rows: torques made with a different,
+// known q̇* per joint (0.004…0.045 rad/s), fitted from q̇* = 0.01 for all. Rows
+// faster than min_speed fix F_v and F_c − F_v q̇* exactly, the slow rows pick
+// q̇* on a log grid (steps of 6.7 %), and F_c follows.
+TEST_F(LeastSquares, EstimatesDqStarPerJoint) {
+  std::mt19937 rng(31u);
+  const Eigen::VectorXd pi = randomTruth(rng);
+  hm::JointVector<Robot> dq_true;
+  for (int j = 0; j < Robot::nj; ++j) dq_true[j] = 0.004 * std::pow(0.045 / 0.004, j / (Robot::nj - 1.0));
+  const Synthetic s = synthesize(*traj_, pi, 4000, dq_true);
+  hi::FitSettings fs;
+  fs.min_speed = 0.05;
+  fs.fit_dq_star = true;
+  const hi::FitResult r = hi::fitBaseParameters<Robot>(*bp_, s.log, fs);
+  for (int j = 0; j < Robot::nj; ++j) {
+    EXPECT_NEAR(r.friction[j].dq_star, dq_true[j], 0.07 * dq_true[j]) << r.friction[j].joint;
+    EXPECT_NEAR(r.friction[j].viscous, pi[Sizes::frictionColumn(j) + 1], 1e-6) << r.friction[j].joint;
+    // eq. 7 outside the band: F_c − F_v q̇* is what the data fix.
+    EXPECT_NEAR(r.friction[j].coulomb - r.friction[j].viscous * r.friction[j].dq_star,
+                pi[Sizes::frictionColumn(j)] - pi[Sizes::frictionColumn(j) + 1] * dq_true[j], 1e-6);
+  }
+  // Without the estimate, q̇* stays at the given value.
+  fs.fit_dq_star = false;
+  const hi::FitResult r0 = hi::fitBaseParameters<Robot>(*bp_, s.log, fs);
+  for (int j = 0; j < Robot::nj; ++j) EXPECT_EQ(r0.friction[j].dq_star, fs.dq_star);
 }
 
 // The whole chain from a 1 kHz log: q with encoder noise, τ with sensor noise,
@@ -436,6 +499,13 @@ TEST(ParametersYaml, UpdatesTheControllerConfiguration) {
   EXPECT_EQ(warnings.size(), 1u);
   EXPECT_EQ(root["safe_mode"]["joints"]["l_knee"]["coulomb"].as<double>(), 9.0);  // other block untouched
   EXPECT_NE(out.find("# ratio 100"), std::string::npos);  // comments kept
+  // dq_star is kept unless asked for (an estimated q̇*, --fit-dq-star).
+  EXPECT_EQ(root["joint_control"]["joints"]["l_knee"]["dq_star"].as<double>(), 0.05);
+  const YAML::Node with_dq = YAML::Load(hi::controllerYamlWithFriction(
+      text, {{"l_knee", 4.25, 1.5, 0.0125}, {"r_hip_yaw", 1.125, 0.5, 0.03}}, nullptr, true));
+  EXPECT_EQ(with_dq["joint_control"]["joints"]["l_knee"]["dq_star"].as<double>(), 0.0125);
+  EXPECT_EQ(with_dq["joint_control"]["joints"]["r_hip_yaw"]["dq_star"].as<double>(), 0.03);
+  EXPECT_EQ(with_dq["joint_control"]["joints"]["l_knee"]["k_f"].as<double>(), 0.8);
   EXPECT_THROW(hi::controllerYamlWithFriction(text, {{"l_ankle_roll", 1, 1, 0.05}}), std::runtime_error);
   EXPECT_THROW(hi::controllerYamlDqStar("controller:\n  dt: 1\n", joints), std::runtime_error);
 #ifdef HQP_CONTROLLER_YAML
