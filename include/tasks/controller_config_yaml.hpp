@@ -227,6 +227,9 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
   {
     const YAML::Node n = r.map(root, "", "estimator", {"contact_threshold"});
     c.estimator.contact_threshold = r.atLeast(n, "estimator", "contact_threshold", 0.0, true);
+    // A foot the QP still loads with fz_min must register as a support (docs/controller.md).
+    if (!(c.estimator.contact_threshold < c.balance.fz_min))
+      r.fail("'estimator.contact_threshold' must be below 'balance.fz_min'");
   }
   {
     const std::string p = "joint_control";

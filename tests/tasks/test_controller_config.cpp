@@ -97,7 +97,8 @@ TEST(ControllerConfig, ShippedFileLoads) {
   EXPECT_EQ(c.balance.com_vertical.kp, 1.0);
   EXPECT_EQ(c.balance.com_vertical.kd, 2.0);
   EXPECT_EQ(c.balance.torsion_radius, 0.05);
-  EXPECT_EQ(c.estimator.contact_threshold, 30.0);
+  EXPECT_EQ(c.estimator.contact_threshold, 8.0);
+  EXPECT_LT(c.estimator.contact_threshold, c.balance.fz_min);
   EXPECT_EQ(c.joint.leak_time, 0.5);
   EXPECT_LT(c.balance.sole_x_min, c.balance.sole_x_max);
   EXPECT_GE(c.balance.sole_x_min, c.planner.sole_x_min);  // CoP region inside the sole
@@ -160,6 +161,8 @@ TEST(ControllerConfig, NegativeOrInvalidValuesAreRejected) {
   expectRejected("com:          {kp: 9, kd: 6}", "com:          {kp: -9, kd: 6}", "balance.com.kp");
   expectRejected("com_vertical: {kp: 1, kd: 2}", "com_vertical: {kp: 1, kd: -2}", "balance.com_vertical.kd");
   expectRejected("  torsion_radius: 0.05", "  torsion_radius: 0", "balance.torsion_radius");
+  // A foot loaded with fz_min must count as in contact.
+  expectRejected("  contact_threshold: 8", "  contact_threshold: 10", "estimator.contact_threshold");
   expectRejected("torso:        {kp: 200, kd: 28.28}", "torso:        {kp: 200, kd: -1}",
                  "balance.torso.kd");
   expectRejected("k_dq: 20}", "k_dq: -20}", "joint_control.joints.l_knee.k_dq");
