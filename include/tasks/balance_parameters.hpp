@@ -13,11 +13,14 @@ namespace hqp::tasks {
 template <int NJ>
 struct BalanceParameters {
   using VectorJ = Eigen::Matrix<double, NJ, 1>;
-  // Critically damped (kd = 2√kp): feet at 20 rad/s, CoM at 10 rad/s, torso at 14 rad/s,
-  // all far below the 1 kHz loop and ordered by priority (stiffer where it matters more).
+  // Critically damped (kd = 2√kp): feet at 20 rad/s, torso at 14 rad/s, far below the 1 kHz
+  // loop. CoM horizontally at 3 rad/s (≈ the LIP's √(g/z)): a 12 N·s push then asks for a ZMP
+  // near the sole edge instead of 4× beyond it; CoM height at 1 rad/s (soft, so that a leaning
+  // torso lowers the CoM a little instead of straightening the knees). docs/tasks.md.
   PdGains foot_linear{400.0, 40.0};
   PdGains foot_angular{400.0, 40.0};
-  PdGains com{100.0, 20.0};
+  PdGains com{9.0, 6.0};
+  PdGains com_vertical{1.0, 2.0};
   PdGains torso{200.0, 28.28};
   double mu = 0.6;        // friction coefficient (rubber sole on floor ~0.8–1; kept conservative)
   double fz_min = 10.0;   // N, unilateral margin: ~2 % of the weight keeps a lightly loaded foot down
@@ -28,6 +31,9 @@ struct BalanceParameters {
   // Level-4 row weights: 1 rad/s² of torso error weighs as much as ~32 N of force error.
   double torso_weight = 1.0;
   double force_weight = 1e-3;
+  // m (> 0): the torsion rows m_z weigh force_weight / torsion_radius² (1 N·m of torsion costs
+  // as much as 1 / torsion_radius N of force); ≤ 0: like the other rows.
+  double torsion_radius = 0.05;
 };
 
 // Defaults with tau_max from the URDF effort limits of Robot.

@@ -1,6 +1,10 @@
 #pragma once
 // Level 4 task: the contact forces towards the planner's reference, [0 I] x = F_ref
 // (NC·CD rows; the first CD entries of each References::contact_force).
+// Row weights: force_weight on every row, except the torsion m_z of a flat foot, which weighs
+// force_weight / r_t² (r_t = torsion_radius): Table I has no torsion limit, and a level that
+// lacks freedom would otherwise buy tiny gains with torsions the sole cannot transmit
+// (|m_z| ≲ μ f_z r_t), spinning the feet (docs/tasks.md).
 
 #include <Eigen/Core>
 
@@ -31,6 +35,11 @@ class ContactForceTask : public hqp::Task<Layout::nf, Layout::nx> {
   template <class P>
   void configure(const P& p) noexcept {
     this->setWeight(p.force_weight);
+    if constexpr (CD == 6) {
+      const double r = p.torsion_radius;
+      const double w = r > 0.0 ? p.force_weight / (r * r) : p.force_weight;
+      for (int c = 0; c < NC; ++c) this->weight(CD * c + 5) = w;
+    }
   }
 
   // F − F_ref for a solution x.

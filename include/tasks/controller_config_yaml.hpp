@@ -183,18 +183,21 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
   {
     const std::string p = "balance";
     const YAML::Node n = r.map(root, "", p,
-                               {"foot_linear", "foot_angular", "com", "torso", "mu", "fz_min",
-                                "cop_region", "torque_limit", "torso_weight", "force_weight"});
+                               {"foot_linear", "foot_angular", "com", "com_vertical", "torso", "mu",
+                                "fz_min", "cop_region", "torque_limit", "torso_weight", "force_weight",
+                                "torsion_radius"});
     BalanceParameters<nj>& b = c.balance;
     b.foot_linear = r.gains(n, p, "foot_linear");
     b.foot_angular = r.gains(n, p, "foot_angular");
     b.com = r.gains(n, p, "com");
+    b.com_vertical = r.gains(n, p, "com_vertical");
     b.torso = r.gains(n, p, "torso");
     b.mu = r.atLeast(n, p, "mu", 0.0, true);
     b.fz_min = r.atLeast(n, p, "fz_min", 0.0, false);
     r.rectangle(n, p, "cop_region", b.sole_x_min, b.sole_x_max, b.sole_y_min, b.sole_y_max);
     b.torso_weight = r.atLeast(n, p, "torso_weight", 0.0, false);
     b.force_weight = r.atLeast(n, p, "force_weight", 0.0, false);
+    b.torsion_radius = r.atLeast(n, p, "torsion_radius", 0.0, true);
     const std::vector<YAML::Node> lim = r.perJoint<Robot>(n, p, "torque_limit");
     for (int j = 0; j < nj; ++j) {
       const std::string key = r.join(p + ".torque_limit", detail::ConfigReader::jointName<Robot>(j));
@@ -224,6 +227,9 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
   {
     const YAML::Node n = r.map(root, "", "estimator", {"contact_threshold"});
     c.estimator.contact_threshold = r.atLeast(n, "estimator", "contact_threshold", 0.0, true);
+    // A foot the QP still loads with fz_min must register as a support (docs/controller.md).
+    if (!(c.estimator.contact_threshold < c.balance.fz_min))
+      r.fail("'estimator.contact_threshold' must be below 'balance.fz_min'");
   }
   {
     const std::string p = "joint_control";

@@ -3,6 +3,8 @@
 //   Ṗ = A_G,lin q̈ + (Ȧ_G v)_lin = m a,   a = a_ff + kp e + kd ė,
 //   e = r_CoM,ref − r_CoM,  ė = v_CoM,ref − v_CoM,
 // so [A_G,lin 0] x = m a − (Ȧ_G v)_lin (3 rows, N).
+// The vertical row has its own gains (`vertical`): the CoM height does not matter for balance,
+// and a stiff height loop straightens the knees when the torso leans (docs/tasks.md).
 
 #include <Eigen/Core>
 
@@ -19,15 +21,17 @@ class LinearMomentumTask : public hqp::Task<3, Layout::nx> {
   using layout = Layout;
   static constexpr int nv = Layout::nv, NC = Layout::num_contacts;
 
-  PdGains gains{100.0, 20.0};
+  PdGains gains{9.0, 6.0};     // horizontal rows (x, y)
+  PdGains vertical{1.0, 2.0};  // vertical row (z)
 
   LinearMomentumTask() { this->name = "linear_momentum"; }
 
   template <class Dyn>
   void update(const Dyn& dyn, const References<NC>& refs) noexcept {
     error_ = refs.com - dyn.com();
-    const Eigen::Vector3d a =
-        refs.com_acceleration + gains.kp * error_ + gains.kd * (refs.com_velocity - dyn.vcom());
+    const Eigen::Vector3d derr = refs.com_velocity - dyn.vcom();
+    Eigen::Vector3d a = refs.com_acceleration + gains.kp * error_ + gains.kd * derr;
+    a.z() = refs.com_acceleration.z() + vertical.kp * error_.z() + vertical.kd * derr.z();
     this->A.template leftCols<nv>() = dyn.Ag().template topRows<3>();
     this->b = dyn.mass() * a - dyn.dAg_v().template head<3>();
   }
@@ -35,6 +39,7 @@ class LinearMomentumTask : public hqp::Task<3, Layout::nx> {
   template <class P>
   void configure(const P& p) noexcept {
     gains = p.com;
+    vertical = p.com_vertical;
   }
 
   // r_CoM,ref − r_CoM at the last update (m).

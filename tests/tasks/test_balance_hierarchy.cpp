@@ -266,10 +266,12 @@ TEST_F(BalanceHierarchy, QuietStandingWqp) {
   EXPECT_LT((tau - gravityCompensation(q, F_static)).cwiseAbs().maxCoeff(), 1e-6);
 }
 
-// CoM reference 0.3 m ahead: k_p e = 30 m/s² asks for ~1300 N of horizontal force, ~3× what
-// friction allows. The contact constraints must hold, the feet must stay put (level 2 exact),
-// and levels 3 and 4 absorb the conflict.
+// CoM reference 0.3 m ahead with a stiff CoM loop (kp = 100 /s², set here: the Walker3 default
+// is softer): k_p e = 30 m/s² asks for ~1300 N of horizontal force, ~3× what friction allows.
+// The contact constraints must hold, the feet must stay put (level 2 exact), and levels 3 and 4
+// absorb the conflict.
 TEST_F(BalanceHierarchy, ExcessiveComDemandKeepsContactsAndFeet) {
+  params.com = {100.0, 20.0};
   Hqp nominal;
   ASSERT_EQ(solve(nominal, refs), hqp::QpStatus::Optimal);
   Refs far = refs;
@@ -304,6 +306,7 @@ TEST_F(BalanceHierarchy, ExcessiveComDemandKeepsContactsAndFeet) {
 // Soft versus strict priority on the same demand: WqpWbc keeps every constraint (they are hard
 // in its single QP) but, unlike HqpWbc above, lets the higher tasks give a little to level 3.
 TEST_F(BalanceHierarchy, ExcessiveComDemandWqpKeepsConstraints) {
+  params.com = {100.0, 20.0};  // the same stiff CoM loop as above
   Refs far = refs;
   far.com.x() += 0.3;
   Wqp wbc;
@@ -421,7 +424,10 @@ TEST_F(BalanceHierarchy, OperationalTasksPullTowardsTheReference) {
   EXPECT_LT((feet.b.segment<3>(6) - kf * Eigen::Vector3d(0.01, -0.02, 0.03)).norm(), 1e-9);
   EXPECT_LT((feet.b.segment<3>(9) - ka * Eigen::Vector3d(0, 0.05, 0)).norm(), 1e-9);
   EXPECT_LT((feet.error().segment<3>(9) - Eigen::Vector3d(0, 0.05, 0)).norm(), 1e-12);
-  EXPECT_LT((com.b - kMass * params.com.kp * Eigen::Vector3d(0.02, 0.0, -0.01)).norm(), 1e-9);
+  // Horizontal rows with the CoM gains, the vertical row with its own.
+  EXPECT_LT((com.b - kMass * Eigen::Vector3d(params.com.kp * 0.02, 0.0, params.com_vertical.kp * -0.01)).norm(),
+            1e-9);
+  EXPECT_NE(params.com.kp, params.com_vertical.kp);  // else the line above cannot tell them apart
   EXPECT_LT((torso.b - params.torso.kp * Eigen::Vector3d(-0.1, 0, 0)).norm(), 1e-9);
   // Rows: the feet's Jacobians, A_G's linear rows (m × CoM Jacobian), the torso's angular rows.
   EXPECT_TRUE((feet.A.block<6, Robot::nv>(6, 0).isApprox(dyn.J(1), 1e-15)));
@@ -434,6 +440,25 @@ TEST_F(BalanceHierarchy, OperationalTasksPullTowardsTheReference) {
 // velocities: the feet (level 2) and the CoM (level 3) are asked for zero classical
 // acceleration, which holds only if the tasks subtract J̇v and Ȧ_G v with the right sign.
 // Checked by central differences of the model's frame and CoM velocities along (v, q̈*).
+// Level-4 force rows: force_weight everywhere except the torsion m_z of each sole, which weighs
+// force_weight / torsion_radius² (1 N·m of torsion as costly as 1 / r N of force).
+TEST_F(BalanceHierarchy, TorsionRowsOfTheForceTaskWeighByTheTorsionRadius) {
+  hqp::tasks::ContactForceTask<Layout> force;
+  force.configure(params);
+  ASSERT_GT(params.torsion_radius, 0.0);
+  for (int c = 0; c < 2; ++c) {
+    for (int k = 0; k < 6; ++k) {
+      const double expected =
+          k == 5 ? params.force_weight / (params.torsion_radius * params.torsion_radius) : params.force_weight;
+      EXPECT_DOUBLE_EQ(force.weight(6 * c + k), expected) << "contact " << c << " row " << k;
+    }
+  }
+  auto p = params;
+  p.torsion_radius = 0.0;  // off: every row alike
+  force.configure(p);
+  EXPECT_TRUE(force.weight.isConstant(p.force_weight));
+}
+
 TEST_F(BalanceHierarchy, MovingRobotBiasTerms) {
   VectorV v;
   v.head<6>() << 0.1, 0.05, -0.02, 0.1, -0.2, 0.15;

@@ -92,9 +92,13 @@ TEST(ControllerConfig, ShippedFileLoads) {
   EXPECT_EQ(c.solver, Config::Solver::Hqp);
   EXPECT_EQ(c.dt, 0.001);
   EXPECT_EQ(c.balance.mu, 0.6);
-  EXPECT_EQ(c.balance.com.kp, 100.0);
-  EXPECT_EQ(c.balance.com.kd, 20.0);
-  EXPECT_EQ(c.estimator.contact_threshold, 30.0);
+  EXPECT_EQ(c.balance.com.kp, 9.0);
+  EXPECT_EQ(c.balance.com.kd, 6.0);
+  EXPECT_EQ(c.balance.com_vertical.kp, 1.0);
+  EXPECT_EQ(c.balance.com_vertical.kd, 2.0);
+  EXPECT_EQ(c.balance.torsion_radius, 0.05);
+  EXPECT_EQ(c.estimator.contact_threshold, 8.0);
+  EXPECT_LT(c.estimator.contact_threshold, c.balance.fz_min);
   EXPECT_EQ(c.joint.leak_time, 0.5);
   EXPECT_LT(c.balance.sole_x_min, c.balance.sole_x_max);
   EXPECT_GE(c.balance.sole_x_min, c.planner.sole_x_min);  // CoP region inside the sole
@@ -134,7 +138,9 @@ TEST(ControllerConfig, PerJointValuesMatchTheUrdfByName) {
 TEST(ControllerConfig, MissingKeyNamesKeyAndFile) {
   expectRejected("  mu: 0.6", "  # mu removed", "balance.mu");
   expectRejected("  max_tilt: 0.8", "  # gone", "safe_mode.max_tilt");
-  expectRejected("{kp: 100, kd: 20}", "{kp: 100}", "balance.com.kd");
+  expectRejected("com:          {kp: 9, kd: 6}", "com:          {kp: 9}", "balance.com.kd");
+  expectRejected("  com_vertical: {kp: 1, kd: 2}", "  # com_vertical gone", "balance.com_vertical");
+  expectRejected("  torsion_radius: 0.05", "  # torsion_radius gone", "balance.torsion_radius");
   expectRejected("    r_knee:         250", "    # r_knee", "balance.torque_limit.r_knee");
   expectRejected("torque_constant: 5, current_limit: 16", "current_limit: 16",  // the left one
                  "joint_control.joints.l_ankle_roll.torque_constant");
@@ -152,7 +158,11 @@ TEST(ControllerConfig, UnknownKeyIsRejected) {
 }
 
 TEST(ControllerConfig, NegativeOrInvalidValuesAreRejected) {
-  expectRejected("{kp: 100, kd: 20}", "{kp: -100, kd: 20}", "balance.com.kp");
+  expectRejected("com:          {kp: 9, kd: 6}", "com:          {kp: -9, kd: 6}", "balance.com.kp");
+  expectRejected("com_vertical: {kp: 1, kd: 2}", "com_vertical: {kp: 1, kd: -2}", "balance.com_vertical.kd");
+  expectRejected("  torsion_radius: 0.05", "  torsion_radius: 0", "balance.torsion_radius");
+  // A foot loaded with fz_min must count as in contact.
+  expectRejected("  contact_threshold: 8", "  contact_threshold: 10", "estimator.contact_threshold");
   expectRejected("torso:        {kp: 200, kd: 28.28}", "torso:        {kp: 200, kd: -1}",
                  "balance.torso.kd");
   expectRejected("k_dq: 20}", "k_dq: -20}", "joint_control.joints.l_knee.k_dq");
