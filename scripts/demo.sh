@@ -4,7 +4,8 @@
 # push_x and push_y series (with a headless MP4 of push_x) and the push sweep. Prints the summary
 # table; everything (CSV, JSON, markdown, PNG plots, MP4) goes to out/ (docs/scenarios.md).
 # Extra arguments go to sim_demo, e.g. `--controller wqp` or `--set noise=true`.
-# Exit code: 0 when every scenario passed, 1 when one failed, 2 on an error.
+# Exit code: 0 when the scenarios ran (the table says which passed; `sim_demo` itself exits 1 when
+# one failed), non-zero on a build or run error.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build="${HQP_BUILD_DIR:-$root/build}"
@@ -19,4 +20,8 @@ status=0
   --video-only push_x --out "$out" "$@" || status=$?
 echo
 echo "== outputs in $out: summary.md / summary.json (table), <scenario>/ (CSV, summary.json, PNG plots), push_x/push_x.mp4 =="
+if [ $status -eq 1 ]; then
+  echo "== some scenario FAILED (see the table above and docs/scenarios.md) =="
+  exit 0
+fi
 exit $status
