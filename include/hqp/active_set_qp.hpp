@@ -210,7 +210,7 @@ class ActiveSetQp {
   Eigen::Matrix<double, NV, 1> ws_mu_;   // reported multipliers (unscaled, ≥ 0)
   Eigen::Matrix<int, NV, 1> ws_prev_row_, ws_prev_upper_;  // warm-start copy
   Eigen::Matrix<int, NV, 1> cand_row_, cand_upper_;        // rows addWarmRows tries
-  MatNN Kw_;                                               // their scaled rows, reduced
+  Eigen::Matrix<double, 8, NV> strip_;                     // 8 of their rows, reduced
   Eigen::Matrix<int, MI, 1> in_ws_;
   Eigen::Matrix<double, NV, 1> rhs_;
   MatNN Q_, R_;
@@ -589,44 +589,48 @@ void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addWarmRows(int nw_prev) {
     in_ws_(j) = 1;  // provisional (a repeated row is skipped); cleared again if rejected
     cand_row_(cnt) = j;
     cand_upper_(cnt) = up ? 1 : 0;
-    for (int c = 0; c < n_; ++c) Kw_(cnt, c) = Cs_(j, c);
     ++cnt;
   }
-  if (cnt == 0) return;
   const int k0 = k_;
-  // Rows into the coordinates of the equalities' reflectors: a Q = a H_0 ⋯ H_{k0−1}.
-  if (k0 > 0) detail::reflectRowStrips<NV>(Kw_, cnt, nv_, Hv_, htau_, 0, k0);
   const double tol2 = settings_.rank_tol * settings_.rank_tol;
-  for (int i = 0; i < cnt; ++i) {
-    const int j = cand_row_(i);
-    const int nz = nv_ - k_;
-    double an2 = 0.0;
-    for (int c = 0; c < n_; ++c) an2 += Cs_(j, c) * Cs_(j, c);
-    for (int c = 0; c < nv_; ++c) w_(c) = Kw_(i, c);
-    const double wn2 = nz > 0 ? w_.segment(k_, nz).squaredNorm() : 0.0;
-    if (nz <= 0 || !(wn2 > tol2 * an2) || an2 == 0.0) {  // dependent on K: not held
-      in_ws_(j) = 0;
-      continue;
+  // Candidates 8 at a time in a local block (one row per lane): all reflectors so far
+  // (equalities, earlier blocks) are applied to the block at once, then each accepted row's
+  // reflector to the whole block, so nothing is stored back between reflectors.
+  for (int s0 = 0; s0 < cnt; s0 += 8) {
+    const int h = std::min(8, cnt - s0);
+    strip_.leftCols(nv_).setZero();
+    for (int l = 0; l < h; ++l)
+      for (int c = 0; c < n_; ++c) strip_(l, c) = Cs_(cand_row_(s0 + l), c);
+    detail::reflectStrip<NV>(strip_, nv_, Hv_, htau_, 0, k_);
+    for (int l = 0; l < h; ++l) {
+      const int j = cand_row_(s0 + l);
+      const int nz = nv_ - k_;
+      double an2 = 0.0;
+      for (int c = 0; c < n_; ++c) an2 += Cs_(j, c) * Cs_(j, c);
+      for (int c = 0; c < nv_; ++c) w_(c) = strip_(l, c);
+      const double wn2 = nz > 0 ? w_.segment(k_, nz).squaredNorm() : 0.0;
+      if (nz <= 0 || !(wn2 > tol2 * an2) || an2 == 0.0) {  // dependent on K: not held
+        in_ws_(j) = 0;
+        continue;
+      }
+      double tau = 0.0, beta = 0.0;
+      if (nz > 1) {
+        w_.segment(k_, nz).makeHouseholderInPlace(tau, beta);
+        Hv_.col(k_).segment(k_ + 1, nz - 1) = w_.segment(k_ + 1, nz - 1);
+      } else {
+        beta = w_(k_);
+      }
+      htau_(k_) = tau;
+      R_.col(k_).head(k_) = w_.head(k_);
+      R_(k_, k_) = beta;
+      R_.col(k_).segment(k_ + 1, nv_ - k_ - 1).setZero();
+      rhs_(k_) = cand_upper_(s0 + l) ? us_(j) : ls_(j);
+      ws_row_(nw_) = j;
+      ws_upper_(nw_) = cand_upper_(s0 + l);
+      ++nw_;
+      ++k_;
+      if (tau != 0.0 && l + 1 < h) detail::reflectStrip<NV>(strip_, nv_, Hv_, htau_, k_ - 1, k_);
     }
-    double tau = 0.0, beta = 0.0;
-    if (nz > 1) {
-      w_.segment(k_, nz).makeHouseholderInPlace(tau, beta);
-      Hv_.col(k_).segment(k_ + 1, nz - 1) = w_.segment(k_ + 1, nz - 1);
-    } else {
-      beta = w_(k_);
-    }
-    htau_(k_) = tau;
-    R_.col(k_).head(k_) = w_.head(k_);
-    R_(k_, k_) = beta;
-    R_.col(k_).segment(k_ + 1, nv_ - k_ - 1).setZero();
-    rhs_(k_) = cand_upper_(i) ? us_(j) : ls_(j);
-    ws_row_(nw_) = j;
-    ws_upper_(nw_) = cand_upper_(i);
-    ++nw_;
-    ++k_;
-    if (tau != 0.0 && i + 1 < cnt)
-      detail::reflectRowStrips<NV>(Kw_.middleRows(i + 1, cnt - i - 1), cnt - i - 1, nv_, Hv_,
-                                   htau_, k_ - 1, k_);
   }
   if (mc_ > 0 && k_ > k0) {  // G ← G H_{k0} ⋯ H_{k−1}
     M_.topLeftCorner(mc_, nv_) = AQ_.topLeftCorner(mc_, nv_);

@@ -15,11 +15,33 @@
 
 namespace hqp::detail {
 
+// strip ← strip H_first ⋯ H_{last−1} on the columns [first, cols) of a local 8-row block.
+template <int MaxCols, class MatV, class VecTau>
+inline void reflectStrip(Eigen::Matrix<double, 8, MaxCols>& strip, int cols, const MatV& V,
+                         const VecTau& tau, int first, int last) {
+  using Vec = Eigen::Matrix<double, 8, 1>;
+  for (int i = first; i < last; ++i) {
+    const double ti = tau(i);
+    if (ti == 0.0) continue;
+    Vec t0 = strip.col(i), t1 = Vec::Zero(), t2 = Vec::Zero(), t3 = Vec::Zero();
+    int j = i + 1;
+    for (; j + 3 < cols; j += 4) {
+      t0.noalias() += V(j, i) * strip.col(j);
+      t1.noalias() += V(j + 1, i) * strip.col(j + 1);
+      t2.noalias() += V(j + 2, i) * strip.col(j + 2);
+      t3.noalias() += V(j + 3, i) * strip.col(j + 3);
+    }
+    for (; j < cols; ++j) t0.noalias() += V(j, i) * strip.col(j);
+    const Vec t = ti * ((t0 + t1) + (t2 + t3));
+    strip.col(i) -= t;
+    for (j = i + 1; j < cols; ++j) strip.col(j).noalias() -= V(j, i) * t;
+  }
+}
+
 template <int MaxCols, class MatY, class MatV, class VecTau>
 inline void reflectRowStrips(MatY&& Y, int rows, int cols, const MatV& V, const VecTau& tau,
                              int first, int last) {
   constexpr int S = 8;
-  using Vec = Eigen::Matrix<double, S, 1>;
   Eigen::Matrix<double, S, MaxCols> strip;
   // Full 8-row strips need a Y that can hold 8 rows (the edge-size QPs have 1-row G).
   constexpr int MaxRowsY = std::decay_t<MatY>::MaxRowsAtCompileTime;
@@ -38,22 +60,7 @@ inline void reflectRowStrips(MatY&& Y, int rows, int cols, const MatV& V, const 
         strip.col(j).head(h) = Y.col(j).segment(r0, h);
       }
     }
-    for (int i = first; i < last; ++i) {
-      const double ti = tau(i);
-      if (ti == 0.0) continue;
-      Vec t0 = strip.col(i), t1 = Vec::Zero(), t2 = Vec::Zero(), t3 = Vec::Zero();
-      int j = i + 1;
-      for (; j + 3 < cols; j += 4) {
-        t0.noalias() += V(j, i) * strip.col(j);
-        t1.noalias() += V(j + 1, i) * strip.col(j + 1);
-        t2.noalias() += V(j + 2, i) * strip.col(j + 2);
-        t3.noalias() += V(j + 3, i) * strip.col(j + 3);
-      }
-      for (; j < cols; ++j) t0.noalias() += V(j, i) * strip.col(j);
-      const Vec t = ti * ((t0 + t1) + (t2 + t3));
-      strip.col(i) -= t;
-      for (j = i + 1; j < cols; ++j) strip.col(j).noalias() -= V(j, i) * t;
-    }
+    reflectStrip<MaxCols>(strip, cols, V, tau, first, last);
     if constexpr (kFull) {
       if (h == S)
         for (int j = first; j < cols; ++j) Y.col(j).template segment<S>(r0) = strip.col(j);
