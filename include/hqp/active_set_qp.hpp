@@ -28,6 +28,7 @@
 #include <cmath>
 #include <limits>
 
+#include "hqp/detail/householder_strips.hpp"
 #include "hqp/detail/qp_min_norm_ls.hpp"
 #include "hqp/qp_settings.hpp"
 #include "hqp/qp_status.hpp"
@@ -156,6 +157,7 @@ class ActiveSetQp {
   bool addRow(int j, bool upper);      // adds C row j (side) to K; false if dependent
   bool addRowVector(double rhs);       // adds a_ (length nv_) to K
   void removeRow(int pos);             // removes K row pos (pos ≥ neq_)
+  void addWarmRows(int nw_prev);       // re-adds ws_prev_* (all at once while Q is implicit)
   bool subproblem();                   // xs_ = optimum on the working set
   bool multipliers();                  // lam_ for K at x = xs_ (needs y_ from subproblem())
   QpStatus iterate(bool phase1);       // the active-set loop on the current phase
@@ -207,6 +209,8 @@ class ActiveSetQp {
   Eigen::Matrix<int, NV, 1> ws_upper_;   // side
   Eigen::Matrix<double, NV, 1> ws_mu_;   // reported multipliers (unscaled, ≥ 0)
   Eigen::Matrix<int, NV, 1> ws_prev_row_, ws_prev_upper_;  // warm-start copy
+  Eigen::Matrix<int, NV, 1> cand_row_, cand_upper_;        // rows addWarmRows tries
+  Eigen::Matrix<double, 8, NV> strip_;                     // 8 of their rows, reduced
   Eigen::Matrix<int, MI, 1> in_ws_;
   Eigen::Matrix<double, NV, 1> rhs_;
   MatNN Q_, R_;
@@ -223,6 +227,7 @@ class ActiveSetQp {
   VecN a_, w_, xs_, xc_, d_, y_, p_, lam_;
   Eigen::Matrix<double, (MR > NV ? MR : NV), 1> work_;  // Householder workspace
   Eigen::Matrix<double, MI, 1> cd_, cx_;  // Ĉ d, Ĉ x (ratio test)
+  bool cx_at_xc_ = false;                 // cx_ = Ĉ xc_ exactly (set by maxViolation(xc_))
   detail::QpMinNormWorkspace<MR, NV> cod_;
 
   VectorX x_;
@@ -560,6 +565,81 @@ bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addRow(int j, bool upper) {
 }
 
 template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addWarmRows(int nw_prev) {
+  // The same as addRow() for each previous working-set row in turn (same acceptance test,
+  // same reflectors), but organised as one right-looking Householder QR of the stacked
+  // rows: each new reflector is applied to all rows still to come, and G = A Q is updated
+  // once at the end, both with the 8-row strip kernel instead of one dot + axpy per row.
+  if (qexplicit_ || trap_ || nv_ != n_) {  // not the state after startPhase(false)
+    for (int w = 0; w < nw_prev; ++w) {
+      const int j = ws_prev_row_(w);
+      const bool up = ws_prev_upper_(w) != 0;
+      if (j < 0 || j >= mi_ || in_ws_(j)) continue;
+      if (!(std::abs(up ? us_(j) : ls_(j)) < kInf)) continue;
+      addRow(j, up);
+    }
+    return;
+  }
+  int cnt = 0;
+  for (int w = 0; w < nw_prev && cnt < NV; ++w) {
+    const int j = ws_prev_row_(w);
+    const bool up = ws_prev_upper_(w) != 0;
+    if (j < 0 || j >= mi_ || in_ws_(j)) continue;
+    if (!(std::abs(up ? us_(j) : ls_(j)) < kInf)) continue;
+    in_ws_(j) = 1;  // provisional (a repeated row is skipped); cleared again if rejected
+    cand_row_(cnt) = j;
+    cand_upper_(cnt) = up ? 1 : 0;
+    ++cnt;
+  }
+  const int k0 = k_;
+  const double tol2 = settings_.rank_tol * settings_.rank_tol;
+  // Candidates 8 at a time in a local block (one row per lane): all reflectors so far
+  // (equalities, earlier blocks) are applied to the block at once, then each accepted row's
+  // reflector to the whole block, so nothing is stored back between reflectors.
+  for (int s0 = 0; s0 < cnt; s0 += 8) {
+    const int h = std::min(8, cnt - s0);
+    strip_.leftCols(nv_).setZero();
+    for (int l = 0; l < h; ++l)
+      for (int c = 0; c < n_; ++c) strip_(l, c) = Cs_(cand_row_(s0 + l), c);
+    detail::reflectStrip<NV>(strip_, nv_, Hv_, htau_, 0, k_);
+    for (int l = 0; l < h; ++l) {
+      const int j = cand_row_(s0 + l);
+      const int nz = nv_ - k_;
+      double an2 = 0.0;
+      for (int c = 0; c < n_; ++c) an2 += Cs_(j, c) * Cs_(j, c);
+      for (int c = 0; c < nv_; ++c) w_(c) = strip_(l, c);
+      const double wn2 = nz > 0 ? w_.segment(k_, nz).squaredNorm() : 0.0;
+      if (nz <= 0 || !(wn2 > tol2 * an2) || an2 == 0.0) {  // dependent on K: not held
+        in_ws_(j) = 0;
+        continue;
+      }
+      double tau = 0.0, beta = 0.0;
+      if (nz > 1) {
+        w_.segment(k_, nz).makeHouseholderInPlace(tau, beta);
+        Hv_.col(k_).segment(k_ + 1, nz - 1) = w_.segment(k_ + 1, nz - 1);
+      } else {
+        beta = w_(k_);
+      }
+      htau_(k_) = tau;
+      R_.col(k_).head(k_) = w_.head(k_);
+      R_(k_, k_) = beta;
+      R_.col(k_).segment(k_ + 1, nv_ - k_ - 1).setZero();
+      rhs_(k_) = cand_upper_(s0 + l) ? us_(j) : ls_(j);
+      ws_row_(nw_) = j;
+      ws_upper_(nw_) = cand_upper_(s0 + l);
+      ++nw_;
+      ++k_;
+      if (tau != 0.0 && l + 1 < h) detail::reflectStrip<NV>(strip_, nv_, Hv_, htau_, k_ - 1, k_);
+    }
+  }
+  if (mc_ > 0 && k_ > k0) {  // G ← G H_{k0} ⋯ H_{k−1}
+    M_.topLeftCorner(mc_, nv_) = AQ_.topLeftCorner(mc_, nv_);
+    detail::reflectRowStrips<NV>(M_, mc_, nv_, Hv_, htau_, k0, k_);
+    AQ_.topLeftCorner(mc_, nv_) = M_.topLeftCorner(mc_, nv_);
+  }
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
 bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::prepare() {
   // Rows scaled to unit norm (zero rows stay zero); non-finite data is rejected
   // (±inf bounds are allowed, NaN bounds are not).
@@ -729,7 +809,9 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
   // Primal active-set loop; xc_ is feasible and satisfies K xc_ = rhs.
   int zero_steps = 0;  // consecutive degenerate steps → smallest-index rule
   int skip_row = -1;   // a blocking row found dependent on K: ignored until K changes
-  if (mi_ > 0) cx_.head(mi_).noalias() = Cs_.topLeftCorner(mi_, n_) * xc_.head(n_);  // Ĉ x
+  // Ĉ x; skipped when the caller's feasibility check just computed it at this xc_.
+  if (mi_ > 0 && !cx_at_xc_) cx_.head(mi_).noalias() = Cs_.topLeftCorner(mi_, n_) * xc_.head(n_);
+  cx_at_xc_ = false;
   for (;;) {
     if (!xs_fresh_ && !subproblem()) return QpStatus::NumericalFailure;
     xs_fresh_ = false;
@@ -839,6 +921,7 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::solveImpl(const VectorX* x_
                                                                bool warm_start) noexcept {
   iterations_ = 0;
   xs_fresh_ = false;
+  cx_at_xc_ = false;
   for (int i = 0; i < me_; ++i) lam_eq_(i) = 0.0;
   const bool warm = warm_start && have_ws_;
   const int nw_prev = nw_;
@@ -872,15 +955,10 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::solveImpl(const VectorX* x_
     ws_prev_row_ = ws_row_;
     ws_prev_upper_ = ws_upper_;
     nw_ = 0;
-    for (int w = 0; w < nw_prev; ++w) {
-      const int j = ws_prev_row_(w);
-      const bool up = ws_prev_upper_(w) != 0;
-      if (j < 0 || j >= mi_ || in_ws_(j)) continue;
-      if (!(std::abs(up ? us_(j) : ls_(j)) < kInf)) continue;
-      addRow(j, up);
-    }
+    addWarmRows(nw_prev);
     if (subproblem() && maxViolation(xs_) <= settings_.feasibility_tol) {
       for (int i = 0; i < n_; ++i) xc_(i) = xs_(i);
+      cx_at_xc_ = true;
       started = true;
       xs_fresh_ = true;  // iterate() starts from this subproblem solution
     } else {
@@ -892,11 +970,13 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::solveImpl(const VectorX* x_
   if (!started && x_init != nullptr && x_init->size() == n_) {
     for (int i = 0; i < n_; ++i) xc_(i) = (*x_init)(i);
     started = xc_.head(n_).allFinite() && maxViolation(xc_) <= settings_.feasibility_tol;
+    cx_at_xc_ = started;
   }
   if (!started) {
     // Minimum-norm point of E x = e (the subproblem with A = 0 would do the same).
     minNormPoint(xc_);
     const double t0 = maxViolation(xc_);
+    cx_at_xc_ = true;  // phase 1 (x part) or phase 2 starts from this xc_
     if (t0 > settings_.feasibility_tol) {
       // Phase 1: min ½t² s.t. Ĉx − t ≤ û, Ĉx + t ≥ l̂, E x = e, from (x_E, t0).
       startPhase(true);

@@ -237,9 +237,15 @@ class HqpWbc {
   }
 
   // Rejects NaN anywhere and infinite matrix entries (bounds may be ±inf); never NaN out.
+  // 0 · v is NaN for ±inf and NaN entries: one vectorized sum per matrix instead of
+  // allFinite()'s element-by-element test.
+  template <class M>
+  static bool finite(const M& m) {
+    return (m.array() * 0.0).sum() == 0.0;
+  }
   bool inputValid() const {
-    if (!A_.allFinite() || !b_.allFinite() || !w_.allFinite() || !D_.allFinite()) return false;
-    if ((w_.array() < 0.0).any()) return false;
+    if (!finite(A_) || !finite(b_) || !finite(w_) || !finite(D_)) return false;
+    if (w_.minCoeff() < 0.0) return false;
     for (int r = 0; r < total_constraint_rows; ++r)
       if (std::isnan(lower_(r)) || std::isnan(upper_(r))) return false;
     return true;
@@ -437,6 +443,7 @@ class HqpWbc {
   bool neutralizeLockedRows(Qp& qp, int c, int own_begin) {
     bool infeasible = false;
     const double tol = settings_.qp.feasibility_tol;
+    cnorm_.head(c) = qp.C().rowwise().squaredNorm();  // all rows at once (vectorized)
     for (int i = 0; i < c; ++i) {
       const double dn = Dnorm_(i);
       if (i < own_begin) {
@@ -445,7 +452,7 @@ class HqpWbc {
         qp.lower()(i) = std::min(qp.lower()(i), 0.0);
         qp.upper()(i) = std::max(qp.upper()(i), 0.0);
       }
-      if (qp.C().row(i).norm() > settings_.rank_tol * dn) continue;
+      if (std::sqrt(cnorm_(i)) > settings_.rank_tol * dn) continue;
       const double sc = rowScale(dn);
       const bool ok = qp.lower()(i) / sc <= tol && -qp.upper()(i) / sc <= tol;
       qp.C().row(i).setZero();
@@ -578,6 +585,7 @@ class HqpWbc {
   Eigen::Matrix<double, capacity(total_task_rows + total_constraint_rows), 1> tmp_ =
       decltype(tmp_)::Zero();
   VectorC Dnorm_ = VectorC::Zero();  // row norms of D
+  VectorC cnorm_ = VectorC::Zero();  // squared row norms of a level's reduced constraint rows
 
   // Cascade state and scratch.
   VectorX x_ = VectorX::Zero();  // x*_p

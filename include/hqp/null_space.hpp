@@ -19,6 +19,7 @@
 #include <cmath>
 #include <utility>
 
+#include "hqp/detail/householder_strips.hpp"
 #include "hqp/hqp_types.hpp"
 
 namespace hqp {
@@ -98,7 +99,14 @@ class NullSpace {
   template <class Dest>
   void applyQOnTheRight(Dest& Y) const {
     if (rank_ == 0) return;
-    Eigen::householderSequence(qr_, tau_).setLength(rank_).applyThisOnTheRight(Y);
+    constexpr int MaxR = Dest::MaxRowsAtCompileTime;
+    if constexpr (MaxR == Eigen::Dynamic || (Dest::Flags & Eigen::RowMajorBit) != 0) {
+      Eigen::householderSequence(qr_, tau_).setLength(rank_).applyThisOnTheRight(Y);
+    } else {
+      // Y H_0 ⋯ H_{k−1} on strips of 8 rows (detail/householder_strips.hpp).
+      detail::reflectRowStrips<capacity(MaxCols)>(Y, static_cast<int>(Y.rows()), cols_, qr_, tau_,
+                                                  0, rank_);
+    }
   }
 
   // y ← Q y for a vector y of size cols() (e.g. u = Q u' back from the rotated coordinates).

@@ -1,0 +1,74 @@
+#pragma once
+// Y ← Y H_first ⋯ H_{last−1} for a column-major Y, with H_i = I − τ_i v_i v_iᵀ and
+// v_i = [0 (i entries); 1; V(i+1 : cols, i)] (Eigen's / LAPACK's reflector storage).
+// Used for the rows below a level (HqpWbc, via NullSpace) and the QP's working-set rows.
+// At these sizes (≤ 66 x 31) a reflector per call of Eigen's gemv + rank-1 update is
+// dominated by call overhead, and dot products of one row end in horizontal reductions.
+// Here 8 rows at a time are copied into a local block and every reflector is fixed-size
+// 8-vector FMAs (one AVX-512 register, two AVX2 registers) on L1 data, with four
+// independent accumulators for t = Y v so the sum is not one serial FMA chain.
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <type_traits>
+
+namespace hqp::detail {
+
+// strip ← strip H_first ⋯ H_{last−1} on the columns [first, cols) of a local 8-row block.
+template <int MaxCols, class MatV, class VecTau>
+inline void reflectStrip(Eigen::Matrix<double, 8, MaxCols>& strip, int cols, const MatV& V,
+                         const VecTau& tau, int first, int last) {
+  using Vec = Eigen::Matrix<double, 8, 1>;
+  for (int i = first; i < last; ++i) {
+    const double ti = tau(i);
+    if (ti == 0.0) continue;
+    Vec t0 = strip.col(i), t1 = Vec::Zero(), t2 = Vec::Zero(), t3 = Vec::Zero();
+    int j = i + 1;
+    for (; j + 3 < cols; j += 4) {
+      t0.noalias() += V(j, i) * strip.col(j);
+      t1.noalias() += V(j + 1, i) * strip.col(j + 1);
+      t2.noalias() += V(j + 2, i) * strip.col(j + 2);
+      t3.noalias() += V(j + 3, i) * strip.col(j + 3);
+    }
+    for (; j < cols; ++j) t0.noalias() += V(j, i) * strip.col(j);
+    const Vec t = ti * ((t0 + t1) + (t2 + t3));
+    strip.col(i) -= t;
+    for (j = i + 1; j < cols; ++j) strip.col(j).noalias() -= V(j, i) * t;
+  }
+}
+
+template <int MaxCols, class MatY, class MatV, class VecTau>
+inline void reflectRowStrips(MatY&& Y, int rows, int cols, const MatV& V, const VecTau& tau,
+                             int first, int last) {
+  constexpr int S = 8;
+  Eigen::Matrix<double, S, MaxCols> strip;
+  // Full 8-row strips need a Y that can hold 8 rows (the edge-size QPs have 1-row G).
+  constexpr int MaxRowsY = std::decay_t<MatY>::MaxRowsAtCompileTime;
+  constexpr bool kFull = MaxRowsY == Eigen::Dynamic || MaxRowsY >= S;
+  if (first >= last || rows <= 0) return;
+  // Reflectors first.. touch only columns ≥ first.
+  for (int r0 = 0; r0 < rows; r0 += S) {
+    const int h = std::min(S, rows - r0);
+    if constexpr (kFull) {
+      if (h == S)
+        for (int j = first; j < cols; ++j) strip.col(j) = Y.col(j).template segment<S>(r0);
+    }
+    if (!kFull || h < S) {
+      for (int j = first; j < cols; ++j) {
+        strip.col(j).setZero();
+        strip.col(j).head(h) = Y.col(j).segment(r0, h);
+      }
+    }
+    reflectStrip<MaxCols>(strip, cols, V, tau, first, last);
+    if constexpr (kFull) {
+      if (h == S)
+        for (int j = first; j < cols; ++j) Y.col(j).template segment<S>(r0) = strip.col(j);
+    }
+    if (!kFull || h < S) {
+      for (int j = first; j < cols; ++j) Y.col(j).segment(r0, h) = strip.col(j).head(h);
+    }
+  }
+}
+
+}  // namespace hqp::detail
