@@ -7,6 +7,7 @@
 //   the wrenches by hand), the foot task keeps a zero residual, levels 3 and 4 pay;
 // - torque saturation: |τ_opt| ≤ tau_max with low knee limits, and a level reports the knee rows.
 // - the contact constraints on a turned and tilted sole, the PD signs of the operational tasks;
+// - a straight leg removes the torso roll from level 4's reach (the reason for the planner's C);
 // - no heap in update + solve + τ_opt + planner (Eigen's guard and a counting operator new).
 // Expected values come from the model layer (checked against MuJoCo in tests/mujoco), closed
 // forms and the robot's total mass, never from the tasks under test.
@@ -18,6 +19,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <new>
+
+#include <Eigen/LU>
+#include <Eigen/SVD>
 
 #include "model/configuration.hpp"
 #include "model/frames.hpp"
@@ -485,6 +489,46 @@ TEST_F(BalanceHierarchy, MovingRobotBiasTerms) {
   const Eigen::Vector3d acom = (plus.vcom() - minus.vcom()) / (2 * dt);
   EXPECT_LT(acom.norm(), 1e-6) << acom.transpose();
   EXPECT_GT(d.dAg_v().head<3>().norm(), 1e-2);
+}
+
+// Why the planner's C must leave the knees bent (controller.yaml, docs/tasks.md "Lateral
+// pushes"): with one leg straight, the level-2 sole rows fix that leg's hip–ankle distance to first
+// order, so in the null space of levels 2–3 (sole pose + CoM) the torso angular rows of level 4
+// lose the roll. Smallest singular value of J_ω N, N = kernel of the level-2/3 task rows (q̈ part;
+// the forces do not enter these rows), computed by SVD (Eigen), not by the hierarchy.
+TEST(BalanceHierarchyGeometry, AStraightLegLeavesLevelFourNoTorsoRoll) {
+  auto smallest = [](double right_knee, Eigen::Vector3d* axis) {
+    VectorQ q = hqp::model::neutralConfiguration<Robot>();
+    const int legs[2] = {Robot::Joints::l_hip_pitch, Robot::Joints::r_hip_pitch};
+    const double knee[2] = {0.6, right_knee};
+    for (int leg = 0; leg < 2; ++leg) {  // hip pitch, knee, ankle pitch; sole parallel to the base
+      q(7 + legs[leg]) = -0.5 * knee[leg];
+      q(7 + legs[leg] + 1) = knee[leg];
+      q(7 + legs[leg] + 2) = -0.5 * knee[leg];
+    }
+    Dyn d(frames());
+    d.calcWbcDependence(q, VectorV::Zero());
+    const Refs r = restingReferences(d);
+    hqp::tasks::ContactPoseTask<Layout> feet;
+    hqp::tasks::LinearMomentumTask<Layout> com;
+    hqp::tasks::TorsoPostureTask<Layout> torso;
+    feet.update(d, r);
+    com.update(d, r);
+    torso.update(d, r);
+    Eigen::Matrix<double, 15, Robot::nv> H;
+    H << feet.A.leftCols<Robot::nv>(), com.A.leftCols<Robot::nv>();
+    const Eigen::FullPivLU<Eigen::Matrix<double, 15, Robot::nv>> lu(H);
+    EXPECT_EQ(lu.rank(), 15);
+    const Eigen::MatrixXd N = lu.kernel();
+    const Eigen::MatrixXd JwN = torso.A.leftCols<Robot::nv>() * N;
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(JwN, Eigen::ComputeFullU);
+    *axis = svd.matrixU().col(2);
+    return svd.singularValues()(2);
+  };
+  Eigen::Vector3d axis;
+  EXPECT_GT(smallest(0.6, &axis), 0.3) << "crouch: level 4 reaches every torso axis";
+  EXPECT_LT(smallest(0.0, &axis), 0.02) << "straight right leg";
+  EXPECT_GT(std::abs(axis.x()), 0.95) << "the lost torso axis is the roll: " << axis.transpose();
 }
 
 // e = log(R_ref Rᵀ) is a WORLD rotation vector: R_ref = exp(ω̂) R gives e = ω for any R,
