@@ -182,11 +182,13 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
       }
     }
     for (int c = 0; c < kContacts; ++c) {
-      const Eigen::Vector2d cop = sim.copInSole(c, s.ft[c]);
+      // Judged on the noise-free F/T wrench (with --set noise=true the controller sees the noisy one).
+      const Vector6 ft = sim.trueForceTorque(c);
+      const Eigen::Vector2d cop = sim.copInSole(c, ft);
       if (!cop.allFinite()) continue;
       r.cop_min[c] = r.cop_min[c].cwiseMin(cop);
       r.cop_max[c] = r.cop_max[c].cwiseMax(cop);
-      if (!(sim.wrenchInSole(c, s.ft[c])[2] >= o.zmp_min_fz)) continue;  // unloaded: no ZMP to check
+      if (!(sim.wrenchInSole(c, ft)[2] >= o.zmp_min_fz)) continue;  // unloaded: no ZMP to check
       const auto& rect = sim.soleRectangle(c);
       const double margin = std::min({cop.x() - rect[0].x(), rect[1].x() - cop.x(), cop.y() - rect[0].y(),
                                       rect[1].y() - cop.y()});

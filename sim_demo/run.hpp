@@ -92,7 +92,7 @@ struct RunSummary {
   long safe_mode_ticks = 0;
   long feet_touch_ticks = 0;       // ticks with the two sole plates in contact with each other
   Eigen::Vector3d ball_impulse = Eigen::Vector3d::Zero();  // N·s the thrown balls lost (delivered)
-  // Measured CoP (sole frame, from the F/T data) extremes per foot while loaded (f_z >= 10 N).
+  // Measured CoP (sole frame, from the noise-free F/T wrench) extremes per foot while loaded (f_z >= 10 N).
   std::array<Eigen::Vector2d, kContacts> cop_min, cop_max;
   double com_x_min = 0, com_x_max = 0;  // m, CoM x excursion relative to t = 0
   double com_y_min = 0, com_y_max = 0;  // m, CoM y excursion relative to t = 0

@@ -171,8 +171,7 @@ void Simulation::readSensors(Sensors& s) {
   for (int c = 0; c < kContacts; ++c) {
     // MuJoCo reads the wrench of the parent (foot) on the massless sole-plate body, which the
     // contact balances exactly: the support's wrench on the foot is its negative.
-    s.ft[c].head<3>() = -Eigen::Vector3d(sd + ft_force_[c]);
-    s.ft[c].tail<3>() = -Eigen::Vector3d(sd + ft_torque_[c]);
+    s.ft[c] = trueForceTorque(c);
   }
   if (!options_.noise) return;
   const SensorNoise& n = plant_.noise;
@@ -292,6 +291,14 @@ bool Simulation::feetTouch() const {
     if ((b1 == sole_body_[0] && b2 == sole_body_[1]) || (b1 == sole_body_[1] && b2 == sole_body_[0])) return true;
   }
   return false;
+}
+
+Vector6 Simulation::trueForceTorque(int c) const {
+  const double* sd = d_->sensordata;
+  Vector6 ft;
+  ft.head<3>() = -Eigen::Vector3d(sd + ft_force_[c]);  // MuJoCo: the foot's wrench on the plate
+  ft.tail<3>() = -Eigen::Vector3d(sd + ft_torque_[c]);
+  return ft;
 }
 
 Vector6 Simulation::wrenchInSole(int c, const Vector6& ft) const {

@@ -95,6 +95,9 @@ class Simulation {
   bool nonFootContact() const;              // a robot geom other than a sole plate is in contact
   bool feetTouch() const;                   // the two sole plates touch each other (corrupts the F/T CoP)
 
+  // The F/T wrench of foot c as SensorData::ft holds it, without sensor noise: what the run's
+  // ZMP metrics judge (noise on a lightly loaded foot would move its CoP by centimetres).
+  Vector6 trueForceTorque(int c) const;
   // Centre of pressure in the sole frame (x, y) from a SensorData F/T wrench (support on foot,
   // sensor frame, about the sensor origin). NaN when f_z < min_fz.
   Eigen::Vector2d copInSole(int c, const Vector6& ft, double min_fz = 10.0) const;
