@@ -275,6 +275,13 @@ def suptitle(fig, title, what, run, fall_time):
 
 # ---- Fig. 8: foot pitch, CoM x, torso pitch -------------------------------------------------------
 
+def plot_angle(ax, t, y, color, label, note):
+    """An angle (deg) with its largest magnitude annotated; note takes (|max|, time)."""
+    plot_line(ax, t, y, color=color, lw=1.0, label=label)
+    m = finite_extreme(t, y, "abs")
+    annotate_point(ax, m, note.format(abs(m[1]), m[0]) if m else "", color)
+
+
 def fig8(run, out, title, pushes, fall_time):
     fig, axes = plt.subplots(3, 1, figsize=(11, 8.5), sharex=True)
     t = run.t
@@ -288,9 +295,7 @@ def fig8(run, out, title, pushes, fall_time):
         not_logged(ax, "foot pitch (r_foot_pitch)")
     else:
         if rp is not None:
-            plot_line(ax, t, rp * deg, color="tab:blue", lw=1.0, label="right foot pitch")
-            m = finite_extreme(t, rp * deg, "abs")
-            annotate_point(ax, m, f"max |pitch| {abs(m[1]):.2f}° at {m[0]:.2f} s" if m else "", "tab:blue")
+            plot_angle(ax, t, rp * deg, "tab:blue", "right foot pitch", "max |pitch| {:.2f}° at {:.2f} s")
         if lp is not None:
             plot_line(ax, t, lp * deg, color="tab:cyan", lw=0.7, alpha=0.8, label="left foot pitch")
         if rr is not None:
@@ -326,9 +331,7 @@ def fig8(run, out, title, pushes, fall_time):
         not_logged(ax, "torso pitch (torso_pitch)")
     else:
         if tp is not None:
-            plot_line(ax, t, tp * deg, color="tab:orange", lw=1.0, label="torso pitch")
-            m = finite_extreme(t, tp * deg, "abs")
-            annotate_point(ax, m, f"max |pitch| {abs(m[1]):.1f}° at {m[0]:.2f} s" if m else "", "tab:orange")
+            plot_angle(ax, t, tp * deg, "tab:orange", "torso pitch", "max |pitch| {:.1f}° at {:.2f} s")
         if tr is not None:
             plot_line(ax, t, tr * deg, color="tab:brown", lw=0.7, ls="--", alpha=0.8, label="torso roll")
             m = finite_extreme(t, tr * deg, "abs")
