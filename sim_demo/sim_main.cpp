@@ -52,16 +52,13 @@ std::string shellQuote(const std::string& s) {
   return q + "'";
 }
 
-// The paper's figures as PNG (sim_demo/plots/plot_scenario.py, matplotlib); a missing Python or
-// matplotlib costs the plots, not the run.
+// The paper's figures as PNG (sim_demo/plots/plot_scenario.py, matplotlib; it finds the pushes,
+// with their impulses, in the CSV); a missing Python or matplotlib costs the plots, not the run.
 std::vector<std::string> makePlots(const Paths& paths, const ScenarioParams& p, const std::string& csv,
                                    const std::string& dir) {
   if (paths.plot_script.empty() || !fs::exists(paths.plot_script)) return {};
-  std::string pushes;
-  for (const hqp::sim::Push& push : p.run.pushes) pushes += (pushes.empty() ? "" : ",") + std::to_string(push.time);
   std::string cmd = shellQuote(paths.python) + " " + shellQuote(paths.plot_script) + " " + shellQuote(csv) + " --out " +
                     shellQuote(dir) + " --title " + shellQuote(p.name + " (" + p.controller + ")");
-  if (!pushes.empty()) cmd += " --pushes " + pushes;
   std::fflush(stdout);
   if (std::system(cmd.c_str()) != 0) {
     std::fprintf(stderr, "sim_demo: plotting failed (%s); the CSV is complete\n", cmd.c_str());
