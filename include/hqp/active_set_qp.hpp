@@ -158,6 +158,10 @@ class ActiveSetQp {
   bool addRowVector(double rhs);       // adds a_ (length nv_) to K
   void removeRow(int pos);             // removes K row pos (pos ≥ neq_)
   void addWarmRows(int nw_prev);       // re-adds ws_prev_* (all at once while Q is implicit)
+  // A previous working-set row that can be re-added: in range, not held yet, finite bound.
+  bool warmUsable(int j, bool up) const {
+    return j >= 0 && j < mi_ && !in_ws_(j) && std::abs(up ? us_(j) : ls_(j)) < kInf;
+  }
   bool subproblem();                   // xs_ = optimum on the working set
   bool multipliers();                  // lam_ for K at x = xs_ (needs y_ from subproblem())
   QpStatus iterate(bool phase1);       // the active-set loop on the current phase
@@ -574,9 +578,7 @@ void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addWarmRows(int nw_prev) {
     for (int w = 0; w < nw_prev; ++w) {
       const int j = ws_prev_row_(w);
       const bool up = ws_prev_upper_(w) != 0;
-      if (j < 0 || j >= mi_ || in_ws_(j)) continue;
-      if (!(std::abs(up ? us_(j) : ls_(j)) < kInf)) continue;
-      addRow(j, up);
+      if (warmUsable(j, up)) addRow(j, up);
     }
     return;
   }
@@ -584,8 +586,7 @@ void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addWarmRows(int nw_prev) {
   for (int w = 0; w < nw_prev && cnt < NV; ++w) {
     const int j = ws_prev_row_(w);
     const bool up = ws_prev_upper_(w) != 0;
-    if (j < 0 || j >= mi_ || in_ws_(j)) continue;
-    if (!(std::abs(up ? us_(j) : ls_(j)) < kInf)) continue;
+    if (!warmUsable(j, up)) continue;
     in_ws_(j) = 1;  // provisional (a repeated row is skipped); cleared again if rejected
     cand_row_(cnt) = j;
     cand_upper_(cnt) = up ? 1 : 0;

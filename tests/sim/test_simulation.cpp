@@ -16,6 +16,7 @@
 #include <string>
 
 #include "run.hpp"
+#include "support/urdf_to_mujoco.hpp"
 #include "scenario.hpp"
 #include "simulation.hpp"
 
@@ -43,14 +44,8 @@ SimulationOptions defaultOptions() {
   return o;
 }
 
-struct ModelDeleter {
-  void operator()(mjModel* m) const { mj_deleteModel(m); }
-};
-struct DataDeleter {
-  void operator()(mjData* d) const { mj_deleteData(d); }
-};
-using ModelPtr = std::unique_ptr<mjModel, ModelDeleter>;
-using DataPtr = std::unique_ptr<mjData, DataDeleter>;
+using ModelPtr = hqp::test::MjModelPtr;
+using DataPtr = hqp::test::MjDataPtr;
 
 ModelPtr loadScene(const std::string& path) {
   char error[1024] = {0};
