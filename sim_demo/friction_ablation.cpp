@@ -134,12 +134,13 @@ nlohmann::ordered_json ablationRecord(const ScenarioParams& ablation, const Abla
 void printAblation(std::FILE* out, const nlohmann::ordered_json& j) {
   std::fprintf(out, "\n== %s (%s): %s ==\n", j["scenario"].get<std::string>().c_str(),
                j["controller"].get<std::string>().c_str(), j["passed"].get<bool>() ? "PASS" : "FAIL");
-  std::fprintf(out, "  %-10s %-7s %-10s %-28s %-22s %s\n", "scenario", "variant", "result", "torque tracking RMS/max",
+  std::fprintf(out, "  %-10s %-7s %-10s %-28s %-22s %s\n", "scenario", "variant", "result", "torque RMS (links) / max",
                "ZMP tracking RMS L/R", "max torso pitch");
   for (const auto& r : j["runs"]) {
     const std::string result =
         r["fell"].get<bool>() ? fmt("FELL %.2f s", r["fall_time"].get<double>()) : (r["passed"].get<bool>() ? "pass" : "FAIL");
-    const std::string tau = fmtOr(r["torque_tracking_rms_Nm"], "%.2f") + " / " + fmtOr(r["torque_tracking_max_Nm"], "%.1f") + " N·m";
+    const std::string tau = fmtOr(r["torque_tracking_rms_Nm"], "%.2f") + " (" + fmtOr(r["torque_tracking_link_rms_Nm"], "%.2f") +
+                            ") / " + fmtOr(r["torque_tracking_max_Nm"], "%.1f") + " N·m";
     const std::string zmp = fmtOr(r["feet"][0]["zmp_tracking_rms_mm"], "%.1f") + " / " +
                             fmtOr(r["feet"][1]["zmp_tracking_rms_mm"], "%.1f") + " mm";
     std::fprintf(out, "  %-10s %-7s %-10s %-28s %-22s %.1f deg\n", r["scenario"].get<std::string>().c_str(),
@@ -155,11 +156,11 @@ std::string ablationMarkdown(const nlohmann::ordered_json& j) {
   s << "**" << j["scenario"].get<std::string>() << "** (" << j["controller"].get<std::string>() << "): "
     << (j["passed"].get<bool>() ? "PASS" : "FAIL") << " — every run must pass its scenario's criterion. "
     << "Torque tracking: τ_opt (eq. 6) minus the joint torque the plant delivered after its friction, "
-       "RMS over ticks and joints, and the largest |error|; ZMP tracking: measured (F/T) minus optimized "
-       "ZMP, RMS per foot.\n\n"
-    << "| scenario | variant | k_f | controller F_c, F_v | result | torque tracking RMS (N·m) | max (N·m) | "
-       "knees RMS L / R (N·m) | ZMP tracking RMS L / R (mm) | max torso pitch (°) | min ZMP margin (mm) |\n"
-    << "|---|---|---|---|---|---|---|---|---|---|---|\n";
+       "RMS over ticks and joints, the same at the links (rotor inertia J_m N² q̈ also taken off), and the "
+       "largest |error|; ZMP tracking: measured (F/T) minus optimized ZMP, RMS per foot.\n\n"
+    << "| scenario | variant | k_f | controller F_c, F_v | result | torque tracking RMS (N·m) | at the links RMS (N·m) | "
+       "max (N·m) | knees RMS L / R (N·m) | ZMP tracking RMS L / R (mm) | max torso pitch (°) | min ZMP margin (mm) |\n"
+    << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& r : j["runs"]) {
     const auto& par = r["parameters"];
     std::string result = r["passed"].get<bool>() ? "PASS" : "FAIL";
@@ -168,6 +169,7 @@ std::string ablationMarkdown(const nlohmann::ordered_json& j) {
     s << "| " << r["scenario"].get<std::string>() << " | " << r["variant"].get<std::string>() << " | "
       << (par["friction_compensation"] == "config" ? std::string("YAML (0.8)") : par["friction_compensation"].get<std::string>())
       << " | " << modelText(par) << " | " << result << " | " << fmtOr(r["torque_tracking_rms_Nm"], "%.2f") << " | "
+      << fmtOr(r["torque_tracking_link_rms_Nm"], "%.2f") << " | "
       << fmtOr(r["torque_tracking_max_Nm"], "%.1f") << " | "
       << (joint.contains("l_knee") ? fmtOr(joint["l_knee"], "%.2f") : "–") << " / "
       << (joint.contains("r_knee") ? fmtOr(joint["r_knee"], "%.2f") : "–") << " | "

@@ -75,6 +75,7 @@ nlohmann::ordered_json runRecord(const ScenarioParams& p, const RunSummary& r) {
   j["feet"] = feet;
   j["torque_tracking_rms_Nm"] = num(r.torque_tracking_rms);
   j["torque_tracking_max_Nm"] = num(r.torque_tracking_max);
+  j["torque_tracking_link_rms_Nm"] = num(r.torque_tracking_link_rms);
   nlohmann::ordered_json tau_joint = nlohmann::ordered_json::object();
   for (int i = 0; i < kJoints; ++i) tau_joint[Robot::bodies[i + 1].joint] = num(r.torque_tracking_rms_joint[i]);
   j["torque_tracking_rms_joint_Nm"] = tau_joint;
@@ -175,8 +176,10 @@ void printRecord(std::FILE* out, const nlohmann::ordered_json& j) {
   }
   std::fprintf(out, "  ZMPs inside soles  : %s\n", j["zmp_inside"].get<bool>() ? "yes" : "NO");
   if (j["torque_tracking_rms_Nm"].is_number()) {
-    std::fprintf(out, "  torque tracking    : RMS %.2f N·m, max %.1f N·m (tau_opt - torque delivered after the joint friction)\n",
-                 j["torque_tracking_rms_Nm"].get<double>(), j["torque_tracking_max_Nm"].get<double>());
+    std::fprintf(out, "  torque tracking    : RMS %.2f N·m, max %.1f N·m (tau_opt - torque delivered after the joint friction); "
+                      "RMS %.2f N·m at the links (rotor inertia off too)\n",
+                 j["torque_tracking_rms_Nm"].get<double>(), j["torque_tracking_max_Nm"].get<double>(),
+                 j["torque_tracking_link_rms_Nm"].get<double>());
   }
   if (!j["level_status_counts"].empty()) {
     std::fprintf(out, "  QP status per level:");

@@ -208,10 +208,17 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
         ++zmp_tracked[c];
       }
     }
+    VectorJ dq0;
+    for (int i = 0; i < kJoints; ++i) dq0[i] = sim.data()->qvel[sim.jointDofAdr(i)];
     sim.step();
     VectorJ tau_err = VectorJ::Constant(std::numeric_limits<double>::quiet_NaN());
     if (driver.jointTargets(targets)) {
       tau_err = targets.tau_opt - sim.deliveredTorque();
+      for (int i = 0; i < kJoints; ++i) {
+        const int dof = sim.jointDofAdr(i);
+        const double ddq = (sim.data()->qvel[dof] - dq0[i]) / sim.controlDt();
+        r.torque_tracking_link_rms += std::pow(tau_err[i] + sim.model()->dof_armature[dof] * ddq, 2);
+      }
       r.torque_tracking_rms_joint += tau_err.cwiseAbs2();
       r.torque_tracking_max = std::max(r.torque_tracking_max, tau_err.cwiseAbs().maxCoeff());
       ++tau_ticks;
@@ -267,9 +274,10 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
   if (solver_ticks > 0) r.lowest_level_error_mean = lowest_error_sum / solver_ticks;
   if (tau_ticks > 0) {
     r.torque_tracking_rms = std::sqrt(r.torque_tracking_rms_joint.sum() / (kJoints * tau_ticks));
+    r.torque_tracking_link_rms = std::sqrt(r.torque_tracking_link_rms / (kJoints * tau_ticks));
     r.torque_tracking_rms_joint = (r.torque_tracking_rms_joint / tau_ticks).cwiseSqrt();
   } else {
-    r.torque_tracking_rms = r.torque_tracking_max = std::numeric_limits<double>::quiet_NaN();
+    r.torque_tracking_rms = r.torque_tracking_max = r.torque_tracking_link_rms = std::numeric_limits<double>::quiet_NaN();
     r.torque_tracking_rms_joint.setConstant(std::numeric_limits<double>::quiet_NaN());
   }
   r.passed = !r.fell && r.safe_mode_ticks == 0 && r.zmp_inside;

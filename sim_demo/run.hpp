@@ -128,6 +128,9 @@ struct RunSummary {
   // joints, RMS per joint, largest |error| (N·m).
   double torque_tracking_rms = 0, torque_tracking_max = 0;
   VectorJ torque_tracking_rms_joint = VectorJ::Zero();
+  // The same with the rotor inertia's torque (MuJoCo armature J_m N² times the tick's mean q̈)
+  // also taken off, i.e. what reaches the links: the controller's rigid-body model has no rotors.
+  double torque_tracking_link_rms = 0;
   // Solver: per level the count of ticks by status (hqp::QpStatus order), and the lowest level's
   // task error ||A x - b||^2 (the paper's Fig. 9(b)).
   int num_levels = 0;

@@ -236,7 +236,9 @@ int main(int argc, char** argv) {
       all_passed = all_passed && record["passed"].get<bool>();
       records.push_back(record);
     }
-    std::string table = hqp::sim::markdownTable(records);
+    bool plain = false;  // a record with a row in the main table
+    for (const auto& r : records) plain = plain || !r.contains("ablation");
+    std::string table = plain ? hqp::sim::markdownTable(records) : std::string();
     for (const auto& r : records) {
       if (r.contains("ablation")) table += "\n" + hqp::sim::ablationMarkdown(r);
     }

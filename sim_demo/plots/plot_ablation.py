@@ -6,7 +6,7 @@
 ABLATION.json is the record sim_demo writes (DIR/ablation.json): its runs, each with a variant and
 the path of its CSV. One row of panels per base scenario:
   (a) joint torque tracking error tau_opt - delivered, RMS over ticks and joints per variant
-      (bars), the knees' RMS as markers;
+      (bars), the knees' RMS (diamonds) and the RMS at the links, rotor inertia off too (bars -);
   (b) ZMP tracking error (measured - optimized), RMS per foot and variant (bars);
   (c) the torque tracking error over time: RMS over the joints, then a moving RMS over
       --window s (default 0.2 s), one line per variant, pushes dotted.
@@ -115,9 +115,11 @@ def main(argv=None):
         tau = [number(r.get("torque_tracking_rms_Nm")) for r in rs]
         knees = [np.sqrt(np.nanmean([number(r.get("torque_tracking_rms_joint_Nm", {}).get(k)) ** 2
                                      for k in ("l_knee", "r_knee")])) for r in rs]
+        link = [number(r.get("torque_tracking_link_rms_Nm")) for r in rs]
         ax = axes[row][0]
         bars(ax, variants, tau, fell, "N·m", f"(a) {scen}: torque tracking RMS", markers=knees,
              marker_label="knees")
+        ax.plot(np.arange(len(variants)), link, "k_", ms=22, mew=2, label="at the links (rotor inertia off)")
         ax.legend(fontsize=8, loc="upper left")
         ax = axes[row][1]
         for k, (foot, off) in enumerate((("left", -0.2), ("right", 0.2))):
