@@ -92,6 +92,7 @@ std::unique_ptr<Driver> makeBalanceController(const std::string& config_path, bo
   config.solver = wqp ? Solver::Wqp : Solver::Hqp;
   auto& joint = config.joint;
   if (overrides.k_f >= 0.0) joint.k_f.setConstant(overrides.k_f);
+  joint.k_dq *= overrides.kinematic_compensation;
   for (int j = 0; j < kJoints; ++j) {
     auto& f = joint.friction[static_cast<std::size_t>(j)];
     if (overrides.plant_friction) {

@@ -23,7 +23,7 @@ const FrictionVariant& variantNamed(const std::string& name) {
   for (const FrictionVariant& v : frictionVariants()) {
     if (name == v.name) return v;
   }
-  throw std::invalid_argument("unknown friction variant '" + name + "' (known: on, off, low, high, config)");
+  throw std::invalid_argument("unknown friction variant '" + name + "' (known: on, off, low, high, config, on_kdq0, off_kdq0)");
 }
 
 // What the controller's friction compensation was in a run, for the table.
@@ -37,11 +37,13 @@ std::string modelText(const nlohmann::ordered_json& params) {
 
 const std::vector<FrictionVariant>& frictionVariants() {
   static const std::vector<FrictionVariant> v = {
-      {"on", 1.0, "plant", 1.0, "k_f = 1, F_c and F_v equal to the plant's"},
-      {"off", 0.0, "plant", 1.0, "k_f = 0: no friction compensation"},
-      {"low", 1.0, "plant", 0.7, "k_f = 1, F_c and F_v 30 % below the plant's"},
-      {"high", 1.0, "plant", 1.3, "k_f = 1, F_c and F_v 30 % above the plant's"},
-      {"config", -1.0, "config", 1.0, "controller.yaml as shipped (k_f = 0.8, its own F_c, F_v)"},
+      {"on", 1.0, "plant", 1.0, 1.0, "k_f = 1, F_c and F_v equal to the plant's"},
+      {"off", 0.0, "plant", 1.0, 1.0, "k_f = 0: no friction compensation"},
+      {"low", 1.0, "plant", 0.7, 1.0, "k_f = 1, F_c and F_v 30 % below the plant's"},
+      {"high", 1.0, "plant", 1.3, 1.0, "k_f = 1, F_c and F_v 30 % above the plant's"},
+      {"config", -1.0, "config", 1.0, 1.0, "controller.yaml as shipped (k_f = 0.8, its own F_c, F_v)"},
+      {"on_kdq0", 1.0, "plant", 1.0, 0.0, "as on, without the kinematic compensation (k_q̇ = 0, eq. 8)"},
+      {"off_kdq0", 0.0, "plant", 1.0, 0.0, "as off, without the kinematic compensation (k_q̇ = 0, eq. 8)"},
   };
   return v;
 }
@@ -58,6 +60,7 @@ ControllerOverrides controllerOverrides(const ScenarioParams& p, const PlantConf
   o.k_f = p.friction_compensation;
   o.plant_friction = p.friction_model == "plant";
   o.friction_model_scale = p.friction_model_scale;
+  o.kinematic_compensation = p.kinematic_compensation;
   if (o.plant_friction) {
     for (int i = 0; i < kJoints; ++i) {
       const JointPlant& j = plant.joint(Robot::bodies[i + 1].joint);
@@ -78,6 +81,7 @@ ScenarioParams ablationRunParams(const ScenarioParams& ablation, const std::stri
   p.friction_compensation = variant.k_f;
   p.friction_model = variant.model;
   p.friction_model_scale = variant.scale;
+  p.kinematic_compensation = variant.kinematic;
   return p;
 }
 
@@ -113,6 +117,7 @@ nlohmann::ordered_json ablationRecord(const ScenarioParams& ablation, const Abla
                         {"k_f", v.k_f < 0 ? nlohmann::ordered_json("config") : nlohmann::ordered_json(v.k_f)},
                         {"friction_model", v.model},
                         {"friction_model_scale", v.scale},
+                        {"kinematic_compensation", v.kinematic},
                         {"meaning", v.meaning}});
   }
   j["variants"] = variants;
@@ -158,9 +163,9 @@ std::string ablationMarkdown(const nlohmann::ordered_json& j) {
     << "Torque tracking: τ_opt (eq. 6) minus the joint torque the plant delivered after its friction, "
        "RMS over ticks and joints, the same at the links (rotor inertia J_m N² q̈ also taken off), and the "
        "largest |error|; ZMP tracking: measured (F/T) minus optimized ZMP, RMS per foot.\n\n"
-    << "| scenario | variant | k_f | controller F_c, F_v | result | torque tracking RMS (N·m) | at the links RMS (N·m) | "
+    << "| scenario | variant | k_f | controller F_c, F_v | k_q̇ | result | torque tracking RMS (N·m) | at the links RMS (N·m) | "
        "max (N·m) | knees RMS L / R (N·m) | ZMP tracking RMS L / R (mm) | max torso pitch (°) | min ZMP margin (mm) |\n"
-    << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    << "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& r : j["runs"]) {
     const auto& par = r["parameters"];
     std::string result = r["passed"].get<bool>() ? "PASS" : "FAIL";
@@ -168,7 +173,8 @@ std::string ablationMarkdown(const nlohmann::ordered_json& j) {
     const auto& joint = r["torque_tracking_rms_joint_Nm"];
     s << "| " << r["scenario"].get<std::string>() << " | " << r["variant"].get<std::string>() << " | "
       << (par["friction_compensation"] == "config" ? std::string("YAML (0.8)") : par["friction_compensation"].get<std::string>())
-      << " | " << modelText(par) << " | " << result << " | " << fmtOr(r["torque_tracking_rms_Nm"], "%.2f") << " | "
+      << " | " << modelText(par) << " | " << (par["kinematic_compensation"] == "1" ? std::string("YAML") : "YAML × " + par["kinematic_compensation"].get<std::string>())
+      << " | " << result << " | " << fmtOr(r["torque_tracking_rms_Nm"], "%.2f") << " | "
       << fmtOr(r["torque_tracking_link_rms_Nm"], "%.2f") << " | "
       << fmtOr(r["torque_tracking_max_Nm"], "%.1f") << " | "
       << (joint.contains("l_knee") ? fmtOr(joint["l_knee"], "%.2f") : "–") << " / "

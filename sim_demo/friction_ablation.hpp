@@ -24,11 +24,13 @@ struct FrictionVariant {
   double k_f;          // < 0: the controller YAML's per joint
   const char* model;   // config | plant
   double scale;        // factor on F_c, F_v
+  double kinematic;    // factor on k_q̇ (eq. 8)
   const char* meaning;
 };
 
 // on: k_f = 1 with the plant's true F_c, F_v; off: k_f = 0; low / high: k_f = 1 with F_c, F_v
-// 30 % below / above the plant's; config: the controller YAML as shipped.
+// 30 % below / above the plant's; config: the controller YAML as shipped; on_kdq0 / off_kdq0: on
+// and off without the kinematic compensation of eq. 8 (its velocity feedback also fights friction).
 const std::vector<FrictionVariant>& frictionVariants();
 bool isFrictionVariant(const std::string& name);
 

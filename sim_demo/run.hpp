@@ -62,6 +62,7 @@ struct ControllerOverrides {
   VectorJ coulomb = VectorJ::Zero();       // N·m, the plant's F_c (used with plant_friction)
   VectorJ viscous = VectorJ::Zero();       // N·m·s/rad, the plant's F_v (used with plant_friction)
   double friction_model_scale = 1.0;       // factor on the resulting F_c and F_v
+  double kinematic_compensation = 1.0;     // factor on k_q̇ (eq. 8)
 };
 std::unique_ptr<Driver> makeBalanceController(const std::string& config_path, bool wqp,
                                               const ControllerOverrides& overrides = {});

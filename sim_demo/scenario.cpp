@@ -197,6 +197,9 @@ const std::vector<Parameter>& parameters() {
       {"friction_model_scale", "factor on the controller's F_c and F_v",
        [](P& p, S k, S v) { p.friction_model_scale = parseDouble(k, v, 0.0, 10.0); },
        [](const P& p) { return formatDouble(p.friction_model_scale); }},
+      {"kinematic_compensation", "factor on the controller's k_q̇ (eq. 8; 0: no kinematic compensation)",
+       [](P& p, S k, S v) { p.kinematic_compensation = parseDouble(k, v, 0.0, 10.0); },
+       [](const P& p) { return formatDouble(p.kinematic_compensation); }},
       {"ablation_scenarios", "friction_ablation: base scenarios (single-run presets)",
        [](P& p, S k, S v) {
          std::vector<std::string> names = split(v, ',');
@@ -213,12 +216,12 @@ const std::vector<Parameter>& parameters() {
          p.ablation_params.scenarios = names;
        },
        [](const P& p) { return join(p.ablation_params.scenarios); }},
-      {"ablation_variants", "friction_ablation: variants among on, off, low, high, config",
+      {"ablation_variants", "friction_ablation: variants among on, off, low, high, config, on_kdq0, off_kdq0",
        [](P& p, S k, S v) {
          std::vector<std::string> names = split(v, ',');
-         if (names.empty()) badValue(k, v, "a list of on, off, low, high, config");
+         if (names.empty()) badValue(k, v, "a list of on, off, low, high, config, on_kdq0, off_kdq0");
          for (const std::string& n : names) {
-           if (!isFrictionVariant(n)) badValue(k, v, "a list of on, off, low, high, config");
+           if (!isFrictionVariant(n)) badValue(k, v, "a list of on, off, low, high, config, on_kdq0, off_kdq0");
          }
          p.ablation_params.variants = names;
        },

@@ -26,7 +26,7 @@ struct SweepParams {
 // (friction_ablation.hpp lists the variants).
 struct AblationParams {
   std::vector<std::string> scenarios = {"push_x", "stand"};
-  std::vector<std::string> variants = {"on", "off", "low", "high", "config"};
+  std::vector<std::string> variants = {"on", "off", "low", "high", "config", "on_kdq0", "off_kdq0"};
 };
 
 struct ScenarioParams {
@@ -45,6 +45,7 @@ struct ScenarioParams {
   double friction_compensation = -1.0;    // k_f of every joint; < 0: the YAML's per joint
   std::string friction_model = "config";  // F_c, F_v: config (the YAML's) or plant (plant.yaml's, the truth)
   double friction_model_scale = 1.0;      // factor on those F_c and F_v
+  double kinematic_compensation = 1.0;    // factor on the YAML's k_q̇ (eq. 8)
   bool ablation = false;                  // friction_ablation: runs instead of one run
   AblationParams ablation_params;
 };

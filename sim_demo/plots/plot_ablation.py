@@ -28,7 +28,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import plot_scenario  # noqa: E402
 
 DPI = 150
-COLORS = {"on": "tab:green", "off": "tab:red", "low": "tab:orange", "high": "tab:purple", "config": "tab:blue"}
+COLORS = {"on": "tab:green", "off": "tab:red", "low": "tab:orange", "high": "tab:purple", "config": "tab:blue",
+          "on_kdq0": "tab:olive", "off_kdq0": "tab:brown"}
 
 
 def moving_rms(t, e, window):
@@ -84,7 +85,7 @@ def bars(ax, variants, values, fell, ylabel, title, markers=None, marker_label=N
     if markers is not None:
         ax.plot(x, markers, "kD", ms=4, label=marker_label)
     ax.set_xticks(np.arange(len(variants)))
-    ax.set_xticklabels(variants)
+    ax.set_xticklabels(variants, rotation=30, ha="right", fontsize=8)
     ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize=10, loc="left")
     ax.grid(axis="y", alpha=0.3)
@@ -154,7 +155,7 @@ def main(argv=None):
         ax.legend(fontsize=8, loc="upper right", ncol=2)
     fig.suptitle(f"Friction-compensation ablation ({rec.get('controller', '?')}): "
                  "on = k_f 1 with the plant's F_c, F_v; off = k_f 0; low / high = model 30 % below / above; "
-                 "config = controller.yaml", fontsize=10)
+                 "config = controller.yaml; _kdq0 = without eq. 8", fontsize=10)
     fig.tight_layout(rect=(0, 0, 1, 0.97))
     fig.savefig(a.out, dpi=DPI)
     plt.close(fig)

@@ -115,6 +115,7 @@ struct Case {
   double k_f;  // expected k_f of every joint (< 0: the YAML's)
   bool plant;  // expected F_c, F_v: the plant's (else the YAML's)
   double scale;
+  double kinematic = 1.0;  // expected factor on the YAML's k_q̇
 };
 
 // A 6 N·s push along X at 0.1 s moves every leg joint through all three branches of eq. 7.
@@ -165,7 +166,7 @@ void checkJointLevel(const Case& c, double& max_error, double& max_tau_f, std::a
       }
       const double k_f = c.k_f < 0 ? j.k_f : c.k_f;
       const double tau_f = k_f * frictionEq7(c.scale * fc, c.scale * fv, j.dq_star, dq_des[i]);
-      const double tau_dq = j.k_dq * (dq_des[i] - s.dq[i]);
+      const double tau_dq = c.kinematic * j.k_dq * (dq_des[i] - s.dq[i]);
       max_error = std::max(max_error, std::abs(cmd.torque[i] - (t.tau_opt[i] + tau_f + tau_dq)));  // eq. 5
       max_tau_f = std::max(max_tau_f, std::abs(tau_f));
       ++branches[dq_des[i] >= j.dq_star ? 0 : dq_des[i] <= -j.dq_star ? 2 : 1];
@@ -183,17 +184,19 @@ TEST(SimFrictionCompensation, ScenarioParametersReachTheJointLevel) {
       {{"friction_compensation=1", "friction_model=plant", nullptr}, 1.0, true, 1.0},
       {{"friction_compensation=1", "friction_model=plant", "friction_model_scale=0.7"}, 1.0, true, 0.7},
       {{nullptr, nullptr, nullptr}, -1.0, false, 1.0},  // the YAML as shipped (k_f 0.8)
+      {{"friction_compensation=0", "kinematic_compensation=0", nullptr}, 0.0, false, 1.0, 0.0},
   };
   double tau_f_on = 0.0;
   for (const Case& c : cases) {
     double err = 0, tau_f = 0;
     std::array<int, 3> branches{};
-    SCOPED_TRACE(c.sets[0] ? std::string(c.sets[0]) + (c.scale != 1.0 ? ", scale " + std::to_string(c.scale) : "")
-                           : std::string("defaults"));
+    std::string what;
+    for (const char* s : c.sets) what += s ? std::string(s) + " " : "";
+    SCOPED_TRACE(what.empty() ? "defaults" : what);
     checkJointLevel(c, err, tau_f, branches);
     EXPECT_LT(err, 1e-9);
     for (int b = 0; b < 3; ++b) EXPECT_GT(branches[b], 20) << "branch " << b << " of eq. 7 barely reached";
-    if (c.k_f == 0.0) EXPECT_EQ(tau_f, 0.0);
+    if (c.k_f == 0.0) EXPECT_EQ(tau_f, 0.0);  // (the expectation had none: err is the check)
     else tau_f_on = std::max(tau_f_on, tau_f);
   }
   // The compensation the k_f = 0 case must not contain is large: that case can fail.
@@ -215,20 +218,21 @@ TEST(SimFrictionCompensation, ParametersAndVariants) {
   hqp::sim::ScenarioParams a = hqp::sim::presetScenario("friction_ablation");
   EXPECT_TRUE(a.ablation);
   hqp::sim::applyAssignment(a, "ablation_scenarios=stand");
-  hqp::sim::applyAssignment(a, "ablation_variants=off,high");
+  hqp::sim::applyAssignment(a, "ablation_variants=off,high,off_kdq0");
   hqp::sim::applyAssignment(a, "controller=wqp");
   std::vector<std::string> seen;
   const auto result = hqp::sim::runFrictionAblation(a, [&](const hqp::sim::ScenarioParams& v, const std::string& name) {
     seen.push_back(v.name + "/" + name);
     EXPECT_EQ(v.controller, "wqp");
     EXPECT_EQ(v.friction_model, "plant");
-    EXPECT_EQ(v.friction_compensation, name == "off" ? 0.0 : 1.0);
+    EXPECT_EQ(v.friction_compensation, name == "high" ? 1.0 : 0.0);
     EXPECT_DOUBLE_EQ(v.friction_model_scale, name == "high" ? 1.3 : 1.0);
+    EXPECT_DOUBLE_EQ(v.kinematic_compensation, name == "off_kdq0" ? 0.0 : 1.0);
     hqp::sim::RunSummary r;
     r.passed = name == "off";
     return r;
   });
-  EXPECT_EQ(seen, (std::vector<std::string>{"stand/off", "stand/high"}));
+  EXPECT_EQ(seen, (std::vector<std::string>{"stand/off", "stand/high", "stand/off_kdq0"}));
   EXPECT_FALSE(result.passed);  // one run failed
 }
 
