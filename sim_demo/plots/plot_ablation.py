@@ -107,7 +107,7 @@ def main(argv=None):
     for r in runs:
         if r["scenario"] not in scenarios:
             scenarios.append(r["scenario"])
-    fig, axes = plt.subplots(len(scenarios), 3, figsize=(16, 4.2 * len(scenarios)), squeeze=False,
+    fig, axes = plt.subplots(len(scenarios), 3, figsize=(16, 4.9 * len(scenarios)), squeeze=False,
                              gridspec_kw={"width_ratios": [1, 1, 2.2]})
     for row, scen in enumerate(scenarios):
         rs = [r for r in runs if r["scenario"] == scen]
@@ -121,7 +121,7 @@ def main(argv=None):
         bars(ax, variants, tau, fell, "N·m", f"(a) {scen}: torque tracking RMS", markers=knees,
              marker_label="knees")
         ax.plot(np.arange(len(variants)), link, "k_", ms=22, mew=2, label="at the links (rotor inertia off)")
-        ax.legend(fontsize=8, loc="upper left")
+        ax.legend(fontsize=7, loc="best")
         ax = axes[row][1]
         for k, (foot, off) in enumerate((("left", -0.2), ("right", 0.2))):
             z = [number(r["feet"][k].get("zmp_tracking_rms_mm")) if len(r.get("feet", [])) > k else np.nan for r in rs]
@@ -152,7 +152,7 @@ def main(argv=None):
         ax.set_title(f"(c) {scen}: |tau_opt - delivered| over the joints, moving RMS {a.window:g} s", fontsize=10,
                      loc="left")
         ax.grid(alpha=0.3, which="both")
-        ax.legend(fontsize=8, loc="upper right", ncol=2)
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=4, frameon=False)
     fig.suptitle(f"Friction-compensation ablation ({rec.get('controller', '?')}): "
                  "on = k_f 1 with the plant's F_c, F_v; off = k_f 0; low / high = model 30 % below / above; "
                  "config = controller.yaml; _kdq0 = without eq. 8", fontsize=10)
