@@ -43,7 +43,7 @@ std::string jointName(int i) { return Robot::bodies[i + 1].joint; }
 // The joint rows of MuJoCo's equation of motion then hold only the actuator, the joint friction
 // and the rigid-body terms, so the delivered torque must equal M q̈ + bias there. Leaving out the
 // frictionloss force (up to F_c = 5.5 N·m) or taking the damping at the start velocity (h D q̈, up
-// to ~0.1 N·m here) breaks the identity by far more than the tolerance.
+// to 0.04 N·m here) breaks the identity by far more than the tolerance (both checked by mutation).
 TEST(SimDeliveredTorque, EqualsTheRigidBodyTorqueInFreeFall) {
   Simulation sim(defaultOptions());
   const mjModel* m = sim.model();
