@@ -13,6 +13,8 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -201,6 +203,55 @@ TEST(SimFrictionCompensation, ScenarioParametersReachTheJointLevel) {
   }
   // The compensation the k_f = 0 case must not contain is large: that case can fail.
   EXPECT_GT(tau_f_on, 2.0);
+}
+
+// The run's torque-tracking summary is the RMS of the CSV's tau_err_<joint> columns (recomputed
+// here from the file, over all ticks and joints) and their largest magnitude.
+TEST(SimFrictionCompensation, TorqueTrackingSummaryMatchesTheCsv) {
+  if (!hqp::sim::balanceControllerAvailable()) GTEST_SKIP() << "built without the balance controller";
+  const std::string config_path =
+      (std::filesystem::path(HQP_SIM_URDF).parent_path() / "controller.yaml").string();
+  Simulation sim(defaultOptions());
+  auto driver = hqp::sim::makeBalanceController(config_path, false);
+  ASSERT_TRUE(driver);
+  hqp::sim::ScenarioParams p = hqp::sim::presetScenario("stand");
+  hqp::sim::applyAssignment(p, "duration=0.5");
+  hqp::sim::RunOptions o = hqp::sim::runOptions(p);
+  o.out_dir = (std::filesystem::temp_directory_path() / "hqp_test_friction_ablation").string();
+  const hqp::sim::RunSummary r = hqp::sim::runScenario(sim, *driver, o);
+  std::ifstream csv(r.csv_path);
+  std::string line;
+  ASSERT_TRUE(std::getline(csv, line));
+  std::vector<int> cols;
+  {
+    std::stringstream h(line);
+    std::string name;
+    for (int c = 0; std::getline(h, name, ','); ++c) {
+      if (name.rfind("tau_err_", 0) == 0) cols.push_back(c);
+    }
+  }
+  ASSERT_EQ(cols.size(), static_cast<std::size_t>(kJoints));
+  double sum = 0.0, max = 0.0;
+  long n = 0;
+  while (std::getline(csv, line)) {
+    std::stringstream row(line);
+    std::string field;
+    std::size_t k = 0;
+    for (int c = 0; std::getline(row, field, ','); ++c) {
+      if (k < cols.size() && c == cols[k]) {
+        const double e = std::stod(field);
+        sum += e * e;
+        max = std::max(max, std::abs(e));
+        ++n;
+        ++k;
+      }
+    }
+  }
+  ASSERT_EQ(n, 500L * kJoints);
+  EXPECT_NEAR(r.torque_tracking_rms, std::sqrt(sum / n), 1e-4);  // the CSV has 4 decimals
+  EXPECT_NEAR(r.torque_tracking_max, max, 1e-4);
+  EXPECT_GT(r.torque_tracking_rms, 0.0);
+  std::filesystem::remove_all(o.out_dir);
 }
 
 TEST(SimFrictionCompensation, ParametersAndVariants) {
