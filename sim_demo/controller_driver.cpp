@@ -59,6 +59,13 @@ class BalanceDriver final : public Driver {
     }
     return true;
   }
+  bool jointTargets(JointTargets& t) const override {
+    if (controller_->diagnostics().mode != hqp::tasks::ControllerMode::Balance) return false;
+    const auto& x = controller_->solution();
+    t.tau_opt = hqp::tasks::jointTorque<Layout>(controller_->dynamics(), x);  // eq. 6, as the tick did
+    t.ddq_opt = x.template segment<kJoints>(6);
+    return true;
+  }
   void logRow(std::FILE* f) const override {
     const auto& d = controller_->diagnostics();
     std::fprintf(f, ",%d", static_cast<int>(d.status));
@@ -78,10 +85,23 @@ class BalanceDriver final : public Driver {
 
 }  // namespace
 
-std::unique_ptr<Driver> makeBalanceController(const std::string& config_path, bool wqp) {
+std::unique_ptr<Driver> makeBalanceController(const std::string& config_path, bool wqp,
+                                              const ControllerOverrides& overrides) {
   auto config = hqp::tasks::loadControllerConfig<Robot>(config_path);
   using Solver = hqp::tasks::ControllerConfig<kJoints>::Solver;
   config.solver = wqp ? Solver::Wqp : Solver::Hqp;
+  auto& joint = config.joint;
+  if (overrides.k_f >= 0.0) joint.k_f.setConstant(overrides.k_f);
+  joint.k_dq *= overrides.kinematic_compensation;
+  for (int j = 0; j < kJoints; ++j) {
+    auto& f = joint.friction[static_cast<std::size_t>(j)];
+    if (overrides.plant_friction) {
+      f.coulomb = overrides.coulomb[j];
+      f.viscous = overrides.viscous[j];
+    }
+    f.coulomb *= overrides.friction_model_scale;
+    f.viscous *= overrides.friction_model_scale;
+  }
   return std::make_unique<BalanceDriver>(config);
 }
 

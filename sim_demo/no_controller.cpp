@@ -3,7 +3,9 @@
 
 namespace hqp::sim {
 
-std::unique_ptr<Driver> makeBalanceController(const std::string&, bool) { return nullptr; }
+std::unique_ptr<Driver> makeBalanceController(const std::string&, bool, const ControllerOverrides&) {
+  return nullptr;
+}
 bool balanceControllerAvailable() { return false; }
 
 }  // namespace hqp::sim

@@ -73,6 +73,12 @@ nlohmann::ordered_json runRecord(const ScenarioParams& p, const RunSummary& r) {
                     {"zmp_tracking_rms_mm", num(r.zmp_tracking_rms[c] * 1e3)}});
   }
   j["feet"] = feet;
+  j["torque_tracking_rms_Nm"] = num(r.torque_tracking_rms);
+  j["torque_tracking_max_Nm"] = num(r.torque_tracking_max);
+  j["torque_tracking_link_rms_Nm"] = num(r.torque_tracking_link_rms);
+  nlohmann::ordered_json tau_joint = nlohmann::ordered_json::object();
+  for (int i = 0; i < kJoints; ++i) tau_joint[Robot::bodies[i + 1].joint] = num(r.torque_tracking_rms_joint[i]);
+  j["torque_tracking_rms_joint_Nm"] = tau_joint;
   j["lowest_level_error_max"] = r.lowest_level_error_max;
   j["lowest_level_error_mean"] = r.lowest_level_error_mean;
   nlohmann::ordered_json levels = nlohmann::ordered_json::array();
@@ -169,6 +175,12 @@ void printRecord(std::FILE* out, const nlohmann::ordered_json& j) {
                  fmtOr(f["zmp_tracking_rms_mm"], "%.1f").c_str());
   }
   std::fprintf(out, "  ZMPs inside soles  : %s\n", j["zmp_inside"].get<bool>() ? "yes" : "NO");
+  if (j["torque_tracking_rms_Nm"].is_number()) {
+    std::fprintf(out, "  torque tracking    : RMS %.2f N·m, max %.1f N·m (tau_opt - torque delivered after the joint friction); "
+                      "RMS %.2f N·m at the links (rotor inertia off too)\n",
+                 j["torque_tracking_rms_Nm"].get<double>(), j["torque_tracking_max_Nm"].get<double>(),
+                 j["torque_tracking_link_rms_Nm"].get<double>());
+  }
   if (!j["level_status_counts"].empty()) {
     std::fprintf(out, "  QP status per level:");
     int l = 1;
@@ -209,7 +221,7 @@ std::string markdownTable(const std::vector<nlohmann::ordered_json>& records) {
     << "|---|---|---|---|---|---|---|---|---|---|---|\n";
   bool push_x = false;
   for (const auto& j : records) {
-    if (j.contains("directions")) continue;
+    if (j.contains("directions") || j.contains("ablation")) continue;  // their own tables
     push_x = push_x || j["scenario"] == "push_x";
     std::string result = j["passed"].get<bool>() ? "PASS" : "FAIL";
     if (j["fell"].get<bool>()) result += fmt(" (fell at %.2f s: ", j["fall_time"].get<double>()) + j["fall_reason"].get<std::string>() + ")";

@@ -45,7 +45,9 @@ class CsvLog {
       for (const char* c : {"fx", "fy", "fz", "mx", "my", "mz"}) std::fprintf(f_, ",%s_ft_%s", foot, c);
     }
     std::fprintf(f_, ",l_cop_x,l_cop_y,r_cop_x,r_cop_y,torso_pitch,torso_roll,torso_z,com_x,com_y,com_z,"
-                     "l_foot_pitch,l_foot_roll,r_foot_pitch,r_foot_roll,push_fx,push_fy,push_fz,ball_px,ball_py,ball_pz,tick_us,safe_mode%s\n", driver_.logHeader().c_str());
+                     "l_foot_pitch,l_foot_roll,r_foot_pitch,r_foot_roll,push_fx,push_fy,push_fz,ball_px,ball_py,ball_pz,tick_us,safe_mode%s", driver_.logHeader().c_str());
+    for (int i = 0; i < kJoints; ++i) std::fprintf(f_, ",tau_err_%s", Robot::bodies[i + 1].joint);
+    std::fputc('\n', f_);
   }
   ~CsvLog() { std::fclose(f_); }
   void row(const Simulation& sim, const Sensors& s, const Eigen::Vector3d& push, double tick_us, bool safe) {
@@ -68,6 +70,10 @@ class CsvLog {
     std::fprintf(f_, ",%.2f,%.2f,%.2f,%.4f,%.4f,%.4f,%.2f,%d", push.x(), push.y(), push.z(), ball.x(), ball.y(), ball.z(),
                  tick_us, safe ? 1 : 0);
     driver_.logRow(f_);
+  }
+  // The row's last columns, known only after the step: τ_opt − delivered torque (NaN: no τ_opt).
+  void endRow(const VectorJ& tau_err) {
+    for (int i = 0; i < kJoints; ++i) std::fprintf(f_, ",%.4f", tau_err[i]);
     std::fputc('\n', f_);
   }
 
@@ -121,6 +127,8 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
     r.zmp_margin[c] = std::numeric_limits<double>::infinity();
   }
   SolverStatus solver;
+  JointTargets targets;
+  long tau_ticks = 0;
   double lowest_error_sum = 0.0;
   long solver_ticks = 0;
   // Delivered ball impulse: momentum at launch (straight flight) minus momentum when the ball
@@ -200,7 +208,22 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
         ++zmp_tracked[c];
       }
     }
+    VectorJ dq0;
+    for (int i = 0; i < kJoints; ++i) dq0[i] = sim.data()->qvel[sim.jointDofAdr(i)];
     sim.step();
+    VectorJ tau_err = VectorJ::Constant(std::numeric_limits<double>::quiet_NaN());
+    if (driver.jointTargets(targets)) {
+      tau_err = targets.tau_opt - sim.deliveredTorque();
+      for (int i = 0; i < kJoints; ++i) {
+        const int dof = sim.jointDofAdr(i);
+        const double ddq = (sim.data()->qvel[dof] - dq0[i]) / sim.controlDt();
+        r.torque_tracking_link_rms += std::pow(tau_err[i] + sim.model()->dof_armature[dof] * ddq, 2);
+      }
+      r.torque_tracking_rms_joint += tau_err.cwiseAbs2();
+      r.torque_tracking_max = std::max(r.torque_tracking_max, tau_err.cwiseAbs().maxCoeff());
+      ++tau_ticks;
+    }
+    if (log) log->endRow(tau_err);
     if (ball_state > 0) {
       const bool touching = sim.ballTouchesRobot();
       if (ball_state == 1 && touching) ball_state = 2;
@@ -249,6 +272,14 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
                                                : std::numeric_limits<double>::quiet_NaN();
   }
   if (solver_ticks > 0) r.lowest_level_error_mean = lowest_error_sum / solver_ticks;
+  if (tau_ticks > 0) {
+    r.torque_tracking_rms = std::sqrt(r.torque_tracking_rms_joint.sum() / (kJoints * tau_ticks));
+    r.torque_tracking_link_rms = std::sqrt(r.torque_tracking_link_rms / (kJoints * tau_ticks));
+    r.torque_tracking_rms_joint = (r.torque_tracking_rms_joint / tau_ticks).cwiseSqrt();
+  } else {
+    r.torque_tracking_rms = r.torque_tracking_max = r.torque_tracking_link_rms = std::numeric_limits<double>::quiet_NaN();
+    r.torque_tracking_rms_joint.setConstant(std::numeric_limits<double>::quiet_NaN());
+  }
   r.passed = !r.fell && r.safe_mode_ticks == 0 && r.zmp_inside;
   // The real-time factor of the loop itself, without video rendering (which is offline work).
   r.real_time_factor = r.duration / std::max(1e-9, r.wall_time - video_s);

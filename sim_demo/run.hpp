@@ -24,6 +24,11 @@ struct SolverStatus {
   std::array<Eigen::Vector2d, kContacts> zmp_optimized;  // from F*, sole frame (m)
 };
 
+struct JointTargets {
+  VectorJ tau_opt = VectorJ::Zero();  // N·m, eq. 6
+  VectorJ ddq_opt = VectorJ::Zero();  // rad/s², q̈* (eqs. 7, 8 integrate it)
+};
+
 // What sits between the sensors and the motors. Virtual is fine here: this is the simulator,
 // not the controller's real-time path.
 class Driver {
@@ -38,6 +43,9 @@ class Driver {
   virtual void logRow(std::FILE*) const {}
   // This tick's solver outcome for the run's metrics; false for drivers without a QP.
   virtual bool solverStatus(SolverStatus&) const { return false; }
+  // This tick's whole-body optimum as the joint level received it: τ_opt (eq. 6) and q̈*; false
+  // for drivers without one (and in the controller's safe mode).
+  virtual bool jointTargets(JointTargets&) const { return false; }
 };
 
 // Joint PD to the standing pose from encoder data only (the stand-in before the balance
@@ -46,7 +54,18 @@ std::unique_ptr<Driver> makeJointPdDriver(const Simulation& sim, double kp = 400
 
 // The balance controller (include/tasks/controller.hpp) configured from a controller YAML file;
 // nullptr when this build has no controller (HQP_SIM_WITH_CONTROLLER off).
-std::unique_ptr<Driver> makeBalanceController(const std::string& config_path, bool wqp);
+// Scenario overrides of the YAML's joint friction compensation (eqs. 5, 7; scenario parameters
+// friction_compensation, friction_model, friction_model_scale).
+struct ControllerOverrides {
+  double k_f = -1.0;                       // k_f of every joint; < 0 keeps the YAML's
+  bool plant_friction = false;             // F_c, F_v := the plant's (the simulation's true friction)
+  VectorJ coulomb = VectorJ::Zero();       // N·m, the plant's F_c (used with plant_friction)
+  VectorJ viscous = VectorJ::Zero();       // N·m·s/rad, the plant's F_v (used with plant_friction)
+  double friction_model_scale = 1.0;       // factor on the resulting F_c and F_v
+  double kinematic_compensation = 1.0;     // factor on k_q̇ (eq. 8)
+};
+std::unique_ptr<Driver> makeBalanceController(const std::string& config_path, bool wqp,
+                                              const ControllerOverrides& overrides = {});
 bool balanceControllerAvailable();
 
 // An impulse on the torso: a constant force impulse / duration at the torso's centre of mass
@@ -105,6 +124,14 @@ struct RunSummary {
   bool zmp_inside = true;
   // Measured minus optimized ZMP (RMS over the ticks both exist, m): torque-tracking quality.
   std::array<double, kContacts> zmp_tracking_rms{};
+  // τ_opt minus the torque the plant delivered after its friction (Simulation::deliveredTorque),
+  // over the ticks with a τ_opt (Driver::jointTargets; NaN without any): RMS over ticks and
+  // joints, RMS per joint, largest |error| (N·m).
+  double torque_tracking_rms = 0, torque_tracking_max = 0;
+  VectorJ torque_tracking_rms_joint = VectorJ::Zero();
+  // The same with the rotor inertia's torque (MuJoCo armature J_m N² times the tick's mean q̈)
+  // also taken off, i.e. what reaches the links: the controller's rigid-body model has no rotors.
+  double torque_tracking_link_rms = 0;
   // Solver: per level the count of ticks by status (hqp::QpStatus order), and the lowest level's
   // task error ||A x - b||^2 (the paper's Fig. 9(b)).
   int num_levels = 0;

@@ -1,5 +1,7 @@
 #include "scenario.hpp"
 
+#include "friction_ablation.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <cerrno>
@@ -183,6 +185,47 @@ const std::vector<Parameter>& parameters() {
       {"sweep_required", "push_sweep: passes when every direction survives this impulse, N·s",
        [](P& p, S k, S v) { p.sweep_params.required = parseDouble(k, v, 0.0, 500.0); },
        [](const P& p) { return formatDouble(p.sweep_params.required); }},
+      {"friction_compensation", "controller's k_f (eq. 5) for every joint, or config (controller YAML's)",
+       [](P& p, S k, S v) { p.friction_compensation = v == "config" ? -1.0 : parseDouble(k, v, 0.0, 2.0); },
+       [](const P& p) { return p.friction_compensation < 0 ? std::string("config") : formatDouble(p.friction_compensation); }},
+      {"friction_model", "controller's F_c, F_v (eq. 7): config (controller YAML's) or plant (plant.yaml's, the truth)",
+       [](P& p, S k, S v) {
+         if (v != "config" && v != "plant") badValue(k, v, "config or plant");
+         p.friction_model = v;
+       },
+       [](const P& p) { return p.friction_model; }},
+      {"friction_model_scale", "factor on the controller's F_c and F_v",
+       [](P& p, S k, S v) { p.friction_model_scale = parseDouble(k, v, 0.0, 10.0); },
+       [](const P& p) { return formatDouble(p.friction_model_scale); }},
+      {"kinematic_compensation", "factor on the controller's k_q̇ (eq. 8; 0: no kinematic compensation)",
+       [](P& p, S k, S v) { p.kinematic_compensation = parseDouble(k, v, 0.0, 10.0); },
+       [](const P& p) { return formatDouble(p.kinematic_compensation); }},
+      {"ablation_scenarios", "friction_ablation: base scenarios (single-run presets)",
+       [](P& p, S k, S v) {
+         std::vector<std::string> names = split(v, ',');
+         if (names.empty()) badValue(k, v, "a list of scenario names");
+         for (const std::string& n : names) {
+           ScenarioParams base;
+           try {
+             base = presetScenario(n);
+           } catch (const std::invalid_argument&) {
+             badValue(k, v, "a list of known scenario names");
+           }
+           if (base.sweep || base.ablation) badValue(k, v, "single-run scenarios");
+         }
+         p.ablation_params.scenarios = names;
+       },
+       [](const P& p) { return join(p.ablation_params.scenarios); }},
+      {"ablation_variants", "friction_ablation: variants among on, off, low, high, config, on_kdq0, off_kdq0",
+       [](P& p, S k, S v) {
+         std::vector<std::string> names = split(v, ',');
+         if (names.empty()) badValue(k, v, "a list of on, off, low, high, config, on_kdq0, off_kdq0");
+         for (const std::string& n : names) {
+           if (!isFrictionVariant(n)) badValue(k, v, "a list of on, off, low, high, config, on_kdq0, off_kdq0");
+         }
+         p.ablation_params.variants = names;
+       },
+       [](const P& p) { return join(p.ablation_params.variants); }},
   };
   return table;
 }
@@ -201,7 +244,7 @@ std::vector<Push> series(double first, double spacing, const std::vector<double>
 
 }  // namespace
 
-std::vector<std::string> scenarioNames() { return {"stand", "push_x", "push_y", "push_sweep"}; }
+std::vector<std::string> scenarioNames() { return {"stand", "push_x", "push_y", "push_sweep", "friction_ablation"}; }
 
 ScenarioParams presetScenario(const std::string& name) {
   ScenarioParams p;
@@ -223,6 +266,9 @@ ScenarioParams presetScenario(const std::string& name) {
     p.description = "largest single impulse survived along +X, -X, +Y, -Y (bisection)";
     p.sweep = true;
     p.run.duration = p.sweep_params.push_time + p.sweep_params.observe;
+  } else if (name == "friction_ablation") {
+    p.description = "base scenarios x joint friction compensation on / off / model 30 % low / high (Sec. V-A)";
+    p.ablation = true;
   } else {
     std::string known;
     for (const std::string& n : scenarioNames()) known += (known.empty() ? "" : ", ") + n;

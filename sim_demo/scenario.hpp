@@ -22,6 +22,13 @@ struct SweepParams {
   double required = 12.0;      // N·s, the sweep passes when every direction survives this (paper: 12)
 };
 
+// friction_ablation: every base scenario under every friction-compensation variant
+// (friction_ablation.hpp lists the variants).
+struct AblationParams {
+  std::vector<std::string> scenarios = {"push_x", "stand"};
+  std::vector<std::string> variants = {"on", "off", "low", "high", "config", "on_kdq0", "off_kdq0"};
+};
+
 struct ScenarioParams {
   std::string name;
   std::string description;
@@ -34,6 +41,13 @@ struct ScenarioParams {
   int substeps = 1;               // physics steps per 1 ms tick
   bool sweep = false;             // push_sweep: bisection instead of one run
   SweepParams sweep_params;
+  // The controller's joint friction compensation (eqs. 5, 7), overriding its YAML.
+  double friction_compensation = -1.0;    // k_f of every joint; < 0: the YAML's per joint
+  std::string friction_model = "config";  // F_c, F_v: config (the YAML's) or plant (plant.yaml's, the truth)
+  double friction_model_scale = 1.0;      // factor on those F_c and F_v
+  double kinematic_compensation = 1.0;    // factor on the YAML's k_q̇ (eq. 8)
+  bool ablation = false;                  // friction_ablation: runs instead of one run
+  AblationParams ablation_params;
 };
 
 // The presets, in the order `--list` shows them.

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "friction_ablation.hpp"
 #include "push_sweep.hpp"
 #include "report.hpp"
 #include "run.hpp"
@@ -76,9 +77,52 @@ std::vector<std::string> makePlots(const Paths& paths, const ScenarioParams& p, 
 std::unique_ptr<hqp::sim::Driver> makeDriver(const std::string& driver_name, const Paths& paths,
                                              const ScenarioParams& p, const hqp::sim::Simulation& sim) {
   if (driver_name == "pd") return hqp::sim::makeJointPdDriver(sim);
-  auto d = hqp::sim::makeBalanceController(paths.controller_config, p.controller == "wqp");
+  auto d = hqp::sim::makeBalanceController(paths.controller_config, p.controller == "wqp",
+                                           hqp::sim::controllerOverrides(p, sim.plant()));
   if (!d) throw std::runtime_error("this build has no balance controller; use --driver pd");
   return d;
+}
+
+hqp::sim::SimulationOptions simulationOptions(const Paths& paths, const ScenarioParams& p) {
+  hqp::sim::SimulationOptions so;
+  so.scene = paths.scene;
+  so.plant = paths.plant;
+  so.noise = p.noise;
+  so.seed = p.seed;
+  so.substeps = p.substeps;
+  return so;
+}
+
+// friction_ablation: each run as a plain run of its base scenario (CSV, summary.json, no video or
+// per-run plots) in DIR/<scenario>_<variant>/, then the table and sim_demo/plots/plot_ablation.py.
+nlohmann::ordered_json runAblation(const Paths& paths, const std::string& driver_name, const ScenarioParams& p,
+                                   const std::string& dir, bool no_plots) {
+  fs::create_directories(dir);
+  const auto run_one = [&](const ScenarioParams& v, const std::string& variant) {
+    hqp::sim::Simulation sim(simulationOptions(paths, v));
+    auto driver = makeDriver(driver_name, paths, v, sim);
+    hqp::sim::RunOptions o = hqp::sim::runOptions(v);
+    o.out_dir = (fs::path(dir) / (v.name + "_" + variant)).string();
+    std::printf("  %s, friction compensation %s ...\n", v.name.c_str(), variant.c_str());
+    std::fflush(stdout);
+    const hqp::sim::RunSummary r = hqp::sim::runScenario(sim, *driver, o);
+    hqp::sim::writeJson((fs::path(o.out_dir) / "summary.json").string(), hqp::sim::runRecord(v, r));
+    return r;
+  };
+  nlohmann::ordered_json record = hqp::sim::ablationRecord(p, hqp::sim::runFrictionAblation(p, run_one));
+  const std::string json = (fs::path(dir) / "ablation.json").string();
+  hqp::sim::writeJson(json, record);
+  hqp::sim::writeText((fs::path(dir) / "ablation.md").string(), hqp::sim::ablationMarkdown(record));
+  const fs::path script = fs::path(paths.plot_script).parent_path() / "plot_ablation.py";
+  if (!no_plots && !paths.plot_script.empty() && fs::exists(script)) {
+    const std::string png = (fs::path(dir) / "friction_ablation.png").string();
+    const std::string cmd = shellQuote(paths.python) + " " + shellQuote(script.string()) + " " + shellQuote(json) +
+                            " --out " + shellQuote(png);
+    std::fflush(stdout);
+    if (std::system(cmd.c_str()) == 0 && fs::exists(png)) record["files"]["plots"].push_back(png);
+    else std::fprintf(stderr, "sim_demo: plotting failed (%s); the JSON is complete\n", cmd.c_str());
+  }
+  return record;
 }
 
 }  // namespace
@@ -151,13 +195,17 @@ int main(int argc, char** argv) {
   try {
     fs::create_directories(out);
     for (const ScenarioParams& p : scenarios) {
-      hqp::sim::SimulationOptions so;
-      so.scene = paths.scene;
-      so.plant = paths.plant;
-      so.noise = p.noise;
-      so.seed = p.seed;
-      so.substeps = p.substeps;
-      hqp::sim::Simulation sim(so);
+      if (p.ablation) {
+        const std::string dir = (fs::path(out) / (p.name + (p.controller == "hqp" ? "" : "_" + p.controller))).string();
+        std::printf("\n== %s: %s ==\n", p.name.c_str(), p.description.c_str());
+        nlohmann::ordered_json record = runAblation(paths, driver_name, p, dir, no_plots);
+        hqp::sim::writeJson((fs::path(dir) / "summary.json").string(), record);
+        hqp::sim::printAblation(stdout, record);
+        all_passed = all_passed && record["passed"].get<bool>();
+        records.push_back(record);
+        continue;
+      }
+      hqp::sim::Simulation sim(simulationOptions(paths, p));
       auto driver = makeDriver(driver_name, paths, p, sim);
       const std::string dir = (fs::path(out) / (p.name + (p.controller == "hqp" ? "" : "_" + p.controller))).string();
       fs::create_directories(dir);
@@ -188,7 +236,12 @@ int main(int argc, char** argv) {
       all_passed = all_passed && record["passed"].get<bool>();
       records.push_back(record);
     }
-    const std::string table = hqp::sim::markdownTable(records);
+    bool plain = false;  // a record with a row in the main table
+    for (const auto& r : records) plain = plain || !r.contains("ablation");
+    std::string table = plain ? hqp::sim::markdownTable(records) : std::string();
+    for (const auto& r : records) {
+      if (r.contains("ablation")) table += "\n" + hqp::sim::ablationMarkdown(r);
+    }
     hqp::sim::writeText((fs::path(out) / "summary.md").string(), "# Walker3 balance scenarios (sim_demo)\n\n" + table);
     hqp::sim::writeJson((fs::path(out) / "summary.json").string(), records);
     std::printf("\n%s\nsummary: %s/summary.md, %s/summary.json\n", table.c_str(), out.c_str(), out.c_str());

@@ -117,6 +117,7 @@ void Simulation::reset() {
   base[2] -= lowest;
   for (int u = 0; u < m_->nu; ++u) d_->ctrl[u] = 0.0;
   ball_flying_ = false;  // mj_resetData parked the ball at its qpos0
+  delivered_.setZero();
   mj_forward(m_, d_);
 }
 
@@ -205,8 +206,10 @@ void Simulation::applyCommand(const Command& c) {
 }
 
 void Simulation::step() {
+  delivered_.setZero();
   for (int k = 0; k < options_.substeps; ++k) {
     mj_step(m_, d_);
+    addDeliveredTorque();
     if (ball_flying_) {
       for (int i = 0; i < d_->ncon; ++i) {
         if (m_->geom_bodyid[d_->contact[i].geom1] == ball_ || m_->geom_bodyid[d_->contact[i].geom2] == ball_) {
@@ -217,6 +220,7 @@ void Simulation::step() {
       }
     }
   }
+  delivered_ /= options_.substeps;
   // mj_step leaves sensordata of the state before its integration: refresh it for the new state.
   mj_forward(m_, d_);
 }
@@ -315,6 +319,23 @@ Eigen::Vector2d Simulation::copInSole(int c, const Vector6& ft, double min_fz) c
   // Moment about the sole origin of a force f at (x, y, 0): m_x = y f_z, m_y = -x f_z (z-parts of f
   // acting in the sole plane only), so the CoP is (-m_y, m_x) / f_z.
   return Eigen::Vector2d(-w[4] / w[2], w[3] / w[2]);
+}
+
+// After mj_step, d_ still holds the forces of the step just taken (only qpos, qvel moved on). The
+// plant's joints have no springs, so their passive torque is the damping alone, which Euler
+// integrates implicitly: -D q̇ at the step's end velocity. A frictionloss row's Jacobian is the unit
+// vector of its dof, so its efc_force is the joint torque directly.
+void Simulation::addDeliveredTorque() {
+  for (int i = 0; i < kJoints; ++i) {
+    const int dof = dofadr_[i];
+    delivered_[i] += d_->qfrc_actuator[dof] - m_->dof_damping[dof] * d_->qvel[dof];
+  }
+  for (int r = 0; r < d_->nefc; ++r) {
+    if (d_->efc_type[r] != mjCNSTR_FRICTION_DOF) continue;
+    for (int i = 0; i < kJoints; ++i) {
+      if (dofadr_[i] == d_->efc_id[r]) delivered_[i] += d_->efc_force[r];
+    }
+  }
 }
 
 }  // namespace hqp::sim

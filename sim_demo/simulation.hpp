@@ -103,9 +103,15 @@ class Simulation {
   Eigen::Vector2d copInSole(int c, const Vector6& ft, double min_fz = 10.0) const;
   // Sole-frame wrench (moment about the sole origin) from the same F/T wrench.
   Vector6 wrenchInSole(int c, const Vector6& ft) const;
+  // Joint torque the plant delivered to the links during the last step() (N·m, mean over the
+  // substeps; zero after reset()): the actuator torque minus the joint's friction, i.e. the viscous
+  // damping at the step's end velocity (Euler integrates it implicitly) and the frictionloss
+  // constraint force (efc_force of the dof's friction row). What the controller's τ_opt asks for.
+  const VectorJ& deliveredTorque() const { return delivered_; }
 
  private:
   int sensorAdr(const std::string& name, int dim) const;
+  void addDeliveredTorque();  // one physics step's share of deliveredTorque()
 
   SimulationOptions options_;
   PlantConfig plant_;
@@ -121,6 +127,7 @@ class Simulation {
   std::array<Eigen::Vector3d, kContacts> p_sole_ft_;  // F/T origin in the sole frame
   std::array<std::array<Eigen::Vector2d, 2>, kContacts> sole_rect_;
   std::mt19937 rng_;
+  VectorJ delivered_ = VectorJ::Zero();  // deliveredTorque()
 };
 
 }  // namespace hqp::sim
