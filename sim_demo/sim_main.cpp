@@ -152,7 +152,7 @@ int main(int argc, char** argv) {
     fs::create_directories(out);
     for (const ScenarioParams& p : scenarios) {
       hqp::sim::SimulationOptions so;
-      so.scene = paths.scene;
+      so.scene = hqp::sim::scenePath(p, paths.scene);  // moving supports bring their own scene
       so.plant = paths.plant;
       so.noise = p.noise;
       so.seed = p.seed;
