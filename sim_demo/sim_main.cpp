@@ -167,7 +167,8 @@ int main(int argc, char** argv) {
       nlohmann::ordered_json record;
       if (p.sweep) {
         const auto on_trial = [](const hqp::sim::SweepDirection& d, const hqp::sim::SweepTrial& t) {
-          std::printf("  %s %6.2f N·s: %s (max pitch %.1f deg, roll %.1f deg)%s%s\n", d.direction.c_str(), t.impulse,
+          std::printf("  %s %6.2f %s: %s (max pitch %.1f deg, roll %.1f deg)%s%s\n", d.direction.c_str(), t.impulse,
+                      d.unit.c_str(),
                       t.run.passed ? "pass" : "FAIL", t.run.max_abs_pitch * 180 / M_PI,
                       t.run.max_abs_roll * 180 / M_PI, t.run.fell ? ", fell: " : "", t.run.fall_reason.c_str());
           std::fflush(stdout);
