@@ -251,6 +251,9 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
       r.max_abs_foot_roll[c] = std::max(r.max_abs_foot_roll[c], std::abs(sim.footRoll(c) - foot_roll0[c]));
       r.max_abs_foot_yaw[c] = std::max(r.max_abs_foot_yaw[c], std::abs(sim.footYaw(c) - foot_yaw0[c]));
       foot_v_lp[c] += lp_alpha * (sim.footVelocity(c) - foot_v_lp[c]);
+      // Only what the robot withstood: the peaks stop at the first ZMP outside a sole (a fall
+      // would add the falling foot's own motion).
+      if (!r.zmp_inside) continue;
       r.foot_angular_velocity_peak[c] = r.foot_angular_velocity_peak[c].cwiseMax(foot_v_lp[c].head<3>().cwiseAbs());
       r.foot_linear_velocity_peak[c] = r.foot_linear_velocity_peak[c].cwiseMax(foot_v_lp[c].tail<3>().cwiseAbs());
     }

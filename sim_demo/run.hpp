@@ -116,7 +116,8 @@ struct RunSummary {
   std::array<std::array<long, 4>, kMaxLevels> level_status_counts{};
   double lowest_level_error_max = 0, lowest_level_error_mean = 0;
   // Moving supports: per foot the peak |component| of the sole's velocity (ground truth from
-  // MuJoCo, world axes, low-passed at foot_velocity_cutoff) and its largest yaw change.
+  // MuJoCo, world axes, low-passed at foot_velocity_cutoff) until the first ZMP outside a sole
+  // (what the robot withstood, not the fall), and its largest yaw change.
   std::array<Eigen::Vector3d, kContacts> foot_angular_velocity_peak, foot_linear_velocity_peak;
   std::array<double, kContacts> max_abs_foot_yaw{};
   bool passed = false;  // no fall, no safe mode, every loaded ZMP inside its sole (+ tolerance)
