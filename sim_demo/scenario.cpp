@@ -379,7 +379,10 @@ ScenarioParams presetScenario(const std::string& name) {
       t.duration = 9.0;
       t.ramp = 1.0;
     }
-    p.run.pushes = series(4.0, 3.0, {8, -8}, Eigen::Vector3d::UnitY());
+    p.run.pushes = series(4.0, 3.0, {8}, Eigen::Vector3d::UnitY());
+    p.run.pushes.push_back(p.run.pushes.back());
+    p.run.pushes.back().time = 7.0;
+    p.run.pushes.back().impulse = Eigen::Vector3d(0.0, -8.0, 0.0);
     p.run.duration = 11.0;
   } else if (name == "skate_sweep") {
     p.description = "largest right-board velocity survived along x, y, z, roll, pitch, yaw (bisection on the skate_* amplitude)";

@@ -118,7 +118,8 @@ int main(int argc, char** argv) {
     for (const std::string& n : hqp::sim::scenarioNames()) {
       std::printf("  %s:", n.c_str());
       for (const auto& [k, v] : hqp::sim::parameterValues(hqp::sim::presetScenario(n))) {
-        if (k == "duration" || k == "pushes") std::printf(" %s=%s", k.c_str(), v.c_str());
+        const bool support = (k == "scene" && v != "scene.xml") || (k.rfind("motion_", 0) == 0 && k != "motion_ramp" && v != "none");
+        if (k == "duration" || k == "pushes" || support) std::printf(" %s=%s", k.c_str(), v.c_str());
       }
       std::printf("\n");
     }
