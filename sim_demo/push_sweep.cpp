@@ -21,6 +21,10 @@ SweepResult runPushSweep(Simulation& sim, Driver& driver, const ScenarioParams& 
                          const std::function<void(const SweepDirection&, const SweepTrial&)>& on_trial) {
   const SweepParams& sp = p.sweep_params;
   if (!(sp.max_impulse > sp.min_impulse)) throw std::invalid_argument("push_sweep: sweep_max must exceed sweep_min");
+  for (const std::string& dir : sp.directions) {  // refuse a wrong direction before any trial
+    if (sp.skate) paperSkatePeak(dir);
+    else unitOf(dir);
+  }
   const auto wall0 = std::chrono::steady_clock::now();
   SweepResult result;
   result.passed = true;

@@ -140,7 +140,7 @@ std::string join(const std::vector<std::string>& items) {
 }
 
 struct Parameter {
-  const char* key;
+  std::string key;
   const char* help;
   std::function<void(ScenarioParams&, const std::string& key, const std::string& value)> set;
   std::function<std::string(const ScenarioParams&)> get;
@@ -246,11 +246,8 @@ const std::vector<Parameter>& parameters() {
   static const std::vector<Parameter> with_motions = [] {
     std::vector<Parameter> t = table;
     // One key per support servo: motion_seesaw, motion_r_board_x, ... (the scene must have it).
-    static std::vector<std::string> keys;
-    keys.reserve(supportAxes().size());
     for (const std::string& axis : supportAxes()) {
-      keys.push_back("motion_" + axis);
-      t.push_back({keys.back().c_str(),
+      t.push_back({"motion_" + axis,
                    "servo target: none or AMP:FREQ:START:DURATION[:OFFSET[:PHASE]] (m or rad, Hz, s, s, m or rad, rad)",
                    [axis](P& p, S k, S v) { parseMotion(motionOf(p, axis), k, v, p.support_ramp); },
                    [axis](const P& p) {
