@@ -66,7 +66,7 @@ std::vector<std::string> makePlots(const Paths& paths, const ScenarioParams& p, 
   }
   std::vector<std::string> files;
   const std::string stem = fs::path(csv).stem().string();
-  for (const char* fig : {"_fig8.png", "_fig9.png", "_fig13.png"}) {
+  for (const char* fig : {"_fig8.png", "_fig9.png", "_fig11.png", "_fig12.png", "_fig13.png", "_fig14.png"}) {
     const fs::path f = fs::path(dir) / (stem + fig);
     if (fs::exists(f)) files.push_back(f.string());
   }
