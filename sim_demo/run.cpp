@@ -35,7 +35,8 @@ class JointPdDriver final : public Driver {
 // A CSV file with one row per tick (docs/simulation.md lists the columns).
 class CsvLog {
  public:
-  CsvLog(const std::string& path, const Driver& driver) : f_(std::fopen(path.c_str(), "w")), driver_(driver) {
+  CsvLog(const std::string& path, const Driver& driver, const std::vector<SupportMotion>& supports)
+      : f_(std::fopen(path.c_str(), "w")), driver_(driver) {
     if (!f_) throw std::runtime_error("cannot write " + path);
     std::setvbuf(f_, nullptr, _IOFBF, 1 << 20);
     std::fprintf(f_, "time");
@@ -45,12 +46,20 @@ class CsvLog {
       for (const char* c : {"fx", "fy", "fz", "mx", "my", "mz"}) std::fprintf(f_, ",%s_ft_%s", foot, c);
     }
     std::fprintf(f_, ",l_cop_x,l_cop_y,r_cop_x,r_cop_y,torso_pitch,torso_roll,torso_z,com_x,com_y,com_z,"
-                     "l_foot_pitch,l_foot_roll,r_foot_pitch,r_foot_roll,push_fx,push_fy,push_fz,ball_px,ball_py,ball_pz,tick_us,safe_mode%s", driver_.logHeader().c_str());
+                     "l_foot_pitch,l_foot_roll,r_foot_pitch,r_foot_roll,push_fx,push_fy,push_fz,ball_px,ball_py,ball_pz,tick_us,safe_mode");
+    // Moving supports: foot yaw and sole velocity (world), then each driven support's position.
+    std::fprintf(f_, ",l_foot_yaw,r_foot_yaw");
+    for (const char* foot : {"l", "r"}) {
+      for (const char* c : {"wx", "wy", "wz", "vx", "vy", "vz"}) std::fprintf(f_, ",%s_foot_%s", foot, c);
+    }
+    for (const SupportMotion& m : supports) std::fprintf(f_, ",support_%s", m.axis.c_str());
+    std::fprintf(f_, "%s", driver_.logHeader().c_str());
     for (int i = 0; i < kJoints; ++i) std::fprintf(f_, ",tau_err_%s", Robot::bodies[i + 1].joint);
     std::fputc('\n', f_);
   }
   ~CsvLog() { std::fclose(f_); }
-  void row(const Simulation& sim, const Sensors& s, const Eigen::Vector3d& push, double tick_us, bool safe) {
+  void row(const Simulation& sim, const Sensors& s, const Eigen::Vector3d& push, double tick_us, bool safe,
+           const std::vector<int>& support_actuators) {
     std::fprintf(f_, "%.4f", s.time);
     const VectorJ q = sim.jointPositions(), tau = sim.appliedTorque();
     for (int i = 0; i < kJoints; ++i) std::fprintf(f_, ",%.6f", q[i]);
@@ -69,6 +78,12 @@ class CsvLog {
     for (int c = 0; c < kContacts; ++c) std::fprintf(f_, ",%.6f,%.6f", sim.footPitch(c), sim.footRoll(c));
     std::fprintf(f_, ",%.2f,%.2f,%.2f,%.4f,%.4f,%.4f,%.2f,%d", push.x(), push.y(), push.z(), ball.x(), ball.y(), ball.z(),
                  tick_us, safe ? 1 : 0);
+    std::fprintf(f_, ",%.6f,%.6f", sim.footYaw(0), sim.footYaw(1));
+    for (int c = 0; c < kContacts; ++c) {
+      const Vector6 v = sim.footVelocity(c);
+      for (int k = 0; k < 6; ++k) std::fprintf(f_, ",%.5f", v[k]);
+    }
+    for (int a : support_actuators) std::fprintf(f_, ",%.6f", sim.supportPosition(a));
     driver_.logRow(f_);
   }
   // The row's last columns, known only after the step: τ_opt − delivered torque (NaN: no τ_opt).
@@ -96,13 +111,15 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
   if (!o.out_dir.empty()) {
     std::filesystem::create_directories(o.out_dir);
     r.csv_path = o.out_dir + "/" + o.scenario + ".csv";
-    log = std::make_unique<CsvLog>(r.csv_path, driver);
+    log = std::make_unique<CsvLog>(r.csv_path, driver, o.supports);
     if (o.video) {
       r.video_path = o.out_dir + "/" + o.scenario + ".mp4";
       video = std::make_unique<VideoRecorder>(sim.model(), r.video_path, o.video_width, o.video_height, o.video_fps,
                                               mj_name2id(sim.model(), mjOBJ_BODY, Robot::bodies[0].name));
     }
   }
+  std::vector<int> support_actuators;
+  for (const SupportMotion& m : o.supports) support_actuators.push_back(sim.supportActuator(m.axis));
   sim.reset();
   driver.reset();
   const long ticks = std::lround(o.duration / sim.controlDt());
@@ -125,7 +142,15 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
     foot_pitch0[c] = sim.footPitch(c);
     foot_roll0[c] = sim.footRoll(c);
     r.zmp_margin[c] = std::numeric_limits<double>::infinity();
+    r.foot_angular_velocity_peak[c].setZero();
+    r.foot_linear_velocity_peak[c].setZero();
   }
+  std::array<double, kContacts> foot_yaw0{};
+  for (int c = 0; c < kContacts; ++c) foot_yaw0[c] = sim.footYaw(c);
+  // First-order low-pass of the foot velocities for their peaks (the paper filters at 20 Hz).
+  const double lp_alpha = sim.controlDt() / (sim.controlDt() + 1.0 / (2.0 * M_PI * o.foot_velocity_cutoff));
+  std::array<Vector6, kContacts> foot_v_lp;
+  for (int c = 0; c < kContacts; ++c) foot_v_lp[c].setZero();
   SolverStatus solver;
   JointTargets targets;
   long tau_ticks = 0;
@@ -143,6 +168,11 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
     tick_us.push_back(us);
     if (driver.safeMode()) ++r.safe_mode_ticks;
     sim.applyCommand(cmd);
+    for (std::size_t i = 0; i < o.supports.size(); ++i) {
+      double q = 0.0, dq = 0.0;
+      supportTarget(o.supports[i], sim.time(), q, dq);
+      sim.setSupportTarget(support_actuators[i], q, dq);
+    }
     Eigen::Vector3d push = Eigen::Vector3d::Zero();
     for (const Push& p : o.pushes) {
       if (p.ball) {
@@ -157,7 +187,7 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
       }
     }
     sim.setTorsoForce(push);
-    if (log) log->row(sim, s, push, us, driver.safeMode());
+    if (log) log->row(sim, s, push, us, driver.safeMode(), support_actuators);
     if (video && sim.time() + 1e-9 >= next_frame) {
       const auto v0 = std::chrono::steady_clock::now();
       // Name the latest push for 0.6 s: a force push is invisible otherwise.
@@ -242,6 +272,13 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
     for (int c = 0; c < kContacts; ++c) {
       r.max_abs_foot_pitch[c] = std::max(r.max_abs_foot_pitch[c], std::abs(sim.footPitch(c) - foot_pitch0[c]));
       r.max_abs_foot_roll[c] = std::max(r.max_abs_foot_roll[c], std::abs(sim.footRoll(c) - foot_roll0[c]));
+      r.max_abs_foot_yaw[c] = std::max(r.max_abs_foot_yaw[c], std::abs(sim.footYaw(c) - foot_yaw0[c]));
+      foot_v_lp[c] += lp_alpha * (sim.footVelocity(c) - foot_v_lp[c]);
+      // Only what the robot withstood: the peaks stop at the first ZMP outside a sole (a fall
+      // would add the falling foot's own motion).
+      if (!r.zmp_inside) continue;
+      r.foot_angular_velocity_peak[c] = r.foot_angular_velocity_peak[c].cwiseMax(foot_v_lp[c].head<3>().cwiseAbs());
+      r.foot_linear_velocity_peak[c] = r.foot_linear_velocity_peak[c].cwiseMax(foot_v_lp[c].tail<3>().cwiseAbs());
     }
     const double pitch = sim.torsoPitch(), roll = sim.torsoRoll(), z = sim.torsoHeight();
     r.max_abs_pitch = std::max(r.max_abs_pitch, std::abs(pitch));

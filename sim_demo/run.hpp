@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include "simulation.hpp"
+#include "support_motion.hpp"
 
 namespace hqp::sim {
 
@@ -95,6 +96,10 @@ struct RunOptions {
   double zmp_min_fz = 30.0;        // N, a foot is loaded (its ZMP counts) above this normal force
   bool progress = false;           // a progress line every simulated second
   std::vector<Push> pushes;
+  // Moving supports: each tick, before the physics step, every listed servo gets its target
+  // (supportTarget at the current time); the scene must have the named actuators.
+  std::vector<SupportMotion> supports;
+  double foot_velocity_cutoff = 20.0;  // Hz, low-pass of the foot velocity peaks (the paper's Fig. 11)
 };
 
 struct RunSummary {
@@ -137,6 +142,11 @@ struct RunSummary {
   int num_levels = 0;
   std::array<std::array<long, 4>, kMaxLevels> level_status_counts{};
   double lowest_level_error_max = 0, lowest_level_error_mean = 0;
+  // Moving supports: per foot the peak |component| of the sole's velocity (ground truth from
+  // MuJoCo, world axes, low-passed at foot_velocity_cutoff) until the first ZMP outside a sole
+  // (what the robot withstood, not the fall), and its largest yaw change.
+  std::array<Eigen::Vector3d, kContacts> foot_angular_velocity_peak, foot_linear_velocity_peak;
+  std::array<double, kContacts> max_abs_foot_yaw{};
   bool passed = false;  // no fall, no safe mode, every loaded ZMP inside its sole (+ tolerance)
   std::string csv_path, video_path;
 };

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <functional>
 #include <sstream>
 #include <stdexcept>
@@ -80,6 +81,49 @@ std::string formatDouble(double x) {
   return b;
 }
 
+// "none" or "AMP:FREQ:START:DURATION[:OFFSET[:PHASE]]" (m or rad, Hz, s, s, m or rad, rad).
+void parseMotion(SupportMotion& m, const std::string& key, const std::string& v, double ramp) {
+  const std::string axis = m.axis;
+  m = SupportMotion{};
+  m.axis = axis;
+  m.ramp = ramp;
+  if (v == "none" || v.empty()) return;
+  const std::vector<std::string> f = split(v, ':');
+  if (f.size() < 4 || f.size() > 6) badValue(key, v, "none or AMP:FREQ:START:DURATION[:OFFSET[:PHASE]], e.g. 0.1:1.5:1.5:4");
+  m.amplitude = parseDouble(key, f[0], -1.0, 1.0);
+  m.frequency = parseDouble(key, f[1], 0.0, 20.0);
+  m.start = parseDouble(key, f[2], 0.0, 3600.0);
+  m.duration = parseDouble(key, f[3], 0.0, 3600.0);
+  if (f.size() > 4) m.offset = parseDouble(key, f[4], -1.0, 1.0);
+  if (f.size() > 5) m.phase = parseDouble(key, f[5], -10.0, 10.0);
+}
+
+std::string formatMotion(const SupportMotion& m) {
+  if (!m.active()) return "none";
+  std::string s = formatDouble(m.amplitude) + ":" + formatDouble(m.frequency) + ":" + formatDouble(m.start) + ":" +
+                  formatDouble(m.duration);
+  if (m.offset != 0.0 || m.phase != 0.0) s += ":" + formatDouble(m.offset);
+  if (m.phase != 0.0) s += ":" + formatDouble(m.phase);
+  return s;
+}
+
+SupportMotion& motionOf(ScenarioParams& p, const std::string& axis) {
+  for (SupportMotion& m : p.supports) {
+    if (m.axis == axis) return m;
+  }
+  p.supports.push_back(SupportMotion{});
+  p.supports.back().axis = axis;
+  p.supports.back().ramp = p.support_ramp;
+  return p.supports.back();
+}
+
+const SupportMotion* findMotion(const ScenarioParams& p, const std::string& axis) {
+  for (const SupportMotion& m : p.supports) {
+    if (m.axis == axis) return &m;
+  }
+  return nullptr;
+}
+
 std::string formatPushes(const std::vector<Push>& pushes) {
   if (pushes.empty()) return "none";
   std::string s;
@@ -98,7 +142,7 @@ std::string join(const std::vector<std::string>& items) {
 }
 
 struct Parameter {
-  const char* key;
+  std::string key;
   const char* help;
   std::function<void(ScenarioParams&, const std::string& key, const std::string& value)> set;
   std::function<std::string(const ScenarioParams&)> get;
@@ -157,23 +201,26 @@ const std::vector<Parameter>& parameters() {
       {"video_fps", "video frame rate",
        [](P& p, S k, S v) { p.run.video_fps = static_cast<int>(parseInt(k, v, 1, 120)); },
        [](const P& p) { return std::to_string(p.run.video_fps); }},
-      {"sweep_directions", "push_sweep: directions among +x,-x,+y,-y",
+      {"sweep_directions", "push_sweep: directions among +x,-x,+y,-y; skate_sweep: axes among x,y,z,roll,pitch,yaw",
        [](P& p, S k, S v) {
+         const char* expected = "a list of +x, -x, +y, -y (push_sweep) or x, y, z, roll, pitch, yaw (skate_sweep)";
          std::vector<std::string> d = split(v, ',');
-         if (d.empty()) badValue(k, v, "a list of +x, -x, +y, -y");
+         if (d.empty()) badValue(k, v, expected);
          for (const std::string& s : d) {
-           if (s != "+x" && s != "-x" && s != "+y" && s != "-y") badValue(k, v, "a list of +x, -x, +y, -y");
+           const bool push = s == "+x" || s == "-x" || s == "+y" || s == "-y";
+           const bool skate = s == "x" || s == "y" || s == "z" || s == "roll" || s == "pitch" || s == "yaw";
+           if (!(push || skate)) badValue(k, v, expected);
          }
          p.sweep_params.directions = d;
        },
        [](const P& p) { return join(p.sweep_params.directions); }},
-      {"sweep_min", "push_sweep: lower bracket end, N·s",
+      {"sweep_min", "sweeps: lower bracket end (push: N·s; skate: fraction of the paper's peak velocity)",
        [](P& p, S k, S v) { p.sweep_params.min_impulse = parseDouble(k, v, 0.0, 500.0); },
        [](const P& p) { return formatDouble(p.sweep_params.min_impulse); }},
-      {"sweep_max", "push_sweep: upper bracket end, N·s",
+      {"sweep_max", "sweeps: upper bracket end (same units)",
        [](P& p, S k, S v) { p.sweep_params.max_impulse = parseDouble(k, v, 0.1, 500.0); },
        [](const P& p) { return formatDouble(p.sweep_params.max_impulse); }},
-      {"sweep_resolution", "push_sweep: stop when the bracket is this narrow, N·s",
+      {"sweep_resolution", "sweeps: stop when the bracket is this narrow (same units)",
        [](P& p, S k, S v) { p.sweep_params.resolution = parseDouble(k, v, 0.01, 100.0); },
        [](const P& p) { return formatDouble(p.sweep_params.resolution); }},
       {"sweep_push_time", "push_sweep: time of the push in each trial, s",
@@ -182,7 +229,7 @@ const std::vector<Parameter>& parameters() {
       {"sweep_observe", "push_sweep: simulated time after the push, s",
        [](P& p, S k, S v) { p.sweep_params.observe = parseDouble(k, v, 0.1, 60.0); },
        [](const P& p) { return formatDouble(p.sweep_params.observe); }},
-      {"sweep_required", "push_sweep: passes when every direction survives this impulse, N·s",
+      {"sweep_required", "sweeps: pass when every direction survives this (push: N·s; skate: fraction, 1 = paper)",
        [](P& p, S k, S v) { p.sweep_params.required = parseDouble(k, v, 0.0, 500.0); },
        [](const P& p) { return formatDouble(p.sweep_params.required); }},
       {"friction_compensation", "controller's k_f (eq. 5) for every joint, or config (controller YAML's)",
@@ -226,8 +273,34 @@ const std::vector<Parameter>& parameters() {
          p.ablation_params.variants = names;
        },
        [](const P& p) { return join(p.ablation_params.variants); }},
+      {"scene", "scene file next to the build's scene.xml (scene_seesaw_x.xml, scene_seesaw_y.xml, scene_skateboards.xml)",
+       [](P& p, S k, S v) {
+         if (v.empty() || v.find('/') != std::string::npos) badValue(k, v, "a file name such as scene_skateboards.xml");
+         p.scene = v;
+       },
+       [](const P& p) { return p.scene; }},
+      {"motion_ramp", "moving supports: raised-cosine ramp in and out of every motion, s",
+       [](P& p, S k, S v) {
+         p.support_ramp = parseDouble(k, v, 0.0, 60.0);
+         for (SupportMotion& m : p.supports) m.ramp = p.support_ramp;
+       },
+       [](const P& p) { return formatDouble(p.support_ramp); }},
   };
-  return table;
+  static const std::vector<Parameter> with_motions = [] {
+    std::vector<Parameter> t = table;
+    // One key per support servo: motion_seesaw, motion_r_board_x, ... (the scene must have it).
+    for (const std::string& axis : supportAxes()) {
+      t.push_back({"motion_" + axis,
+                   "servo target: none or AMP:FREQ:START:DURATION[:OFFSET[:PHASE]] (m or rad, Hz, s, s, m or rad, rad)",
+                   [axis](P& p, S k, S v) { parseMotion(motionOf(p, axis), k, v, p.support_ramp); },
+                   [axis](const P& p) {
+                     const SupportMotion* m = findMotion(p, axis);
+                     return m ? formatMotion(*m) : std::string("none");
+                   }});
+    }
+    return t;
+  }();
+  return with_motions;
 }
 
 std::vector<Push> series(double first, double spacing, const std::vector<double>& magnitudes,
@@ -244,7 +317,34 @@ std::vector<Push> series(double first, double spacing, const std::vector<double>
 
 }  // namespace
 
-std::vector<std::string> scenarioNames() { return {"stand", "push_x", "push_y", "push_sweep", "friction_ablation"}; }
+std::vector<std::string> scenarioNames() {
+  return {"stand",      "push_x",     "push_y",      "push_sweep", "friction_ablation", "seesaw_x",    "seesaw_y",
+          "skate_x",    "skate_y",    "skate_z",     "skate_roll", "skate_pitch", "skate_yaw",
+          "skate_mixed", "skate_sweep"};
+}
+
+const std::vector<std::string>& supportAxes() {
+  static const std::vector<std::string> axes = {
+      "seesaw",    "r_board_x", "r_board_y", "r_board_z", "r_board_roll", "r_board_pitch", "r_board_yaw",
+      "l_board_x", "l_board_y", "l_board_z", "l_board_roll", "l_board_pitch", "l_board_yaw"};
+  return axes;
+}
+
+double paperSkatePeak(const std::string& axis) {
+  // Section VI-C: 0.94, 0.89, 0.47 m/s along X, Y, Z; 1.8, 1.4, 0.5 rad/s about X, Y, Z.
+  if (axis == "x") return 0.94;
+  if (axis == "y") return 0.89;
+  if (axis == "z") return 0.47;
+  if (axis == "roll") return 1.8;
+  if (axis == "pitch") return 1.4;
+  if (axis == "yaw") return 0.5;
+  throw std::invalid_argument("skate axis '" + axis + "' (expected x, y, z, roll, pitch or yaw)");
+}
+
+std::string scenePath(const ScenarioParams& p, const std::string& default_scene) {
+  if (p.scene.empty() || p.scene == "scene.xml") return default_scene;
+  return (std::filesystem::path(default_scene).parent_path() / p.scene).string();
+}
 
 ScenarioParams presetScenario(const std::string& name) {
   ScenarioParams p;
@@ -262,6 +362,79 @@ ScenarioParams presetScenario(const std::string& name) {
     p.description = "seven impulses along +Y at the torso, 3 s apart (8, 10, 11, 12 x4 N·s)";
     p.run.pushes = series(kFirst, kSpacing, {8, 10, 11, 12, 12, 12, 12}, Eigen::Vector3d::UnitY());
     p.run.duration = p.run.pushes.back().time + kAfter;
+  } else if (name == "seesaw_x" || name == "seesaw_y") {
+    // Section VI-B: a hinged board driven by its servo, +-6 deg; the frequency gives the paper's
+    // peak foot angular velocity with 2 % to spare (0.6 rad/s about X, 1.0 rad/s about Y).
+    const bool x = name == "seesaw_x";
+    p.description = std::string("seesaw about ") + (x ? "X" : "Y") + ": +-6 deg sinusoid, peak " +
+                    (x ? "0.61" : "1.02") + " rad/s, from 1.5 s for 6 s";
+    p.scene = x ? "scene_seesaw_x.xml" : "scene_seesaw_y.xml";
+    SupportMotion& m = motionOf(p, "seesaw");
+    m.amplitude = 6.0 * M_PI / 180.0;
+    m.frequency = (x ? 0.6 : 1.0) * 1.02 / (2.0 * M_PI * m.amplitude);
+    m.start = 1.5;
+    m.duration = 6.0;
+    p.run.duration = m.start + m.duration + 1.5;
+  } else if (name.rfind("skate_", 0) == 0 && name != "skate_mixed" && name != "skate_sweep") {
+    // Section VI-C: the right board moves along one axis, the left one is locked. Amplitude and
+    // frequency give the paper's peak foot velocity with 2 % to spare (the metric is the
+    // measured foot velocity). Y is offset outwards: the soles are only 8 cm apart.
+    const std::string axis = name.substr(6);
+    p.scene = "scene_skateboards.xml";
+    SupportMotion& m = motionOf(p, "r_board_" + axis);
+    const double peak = 1.02 * paperSkatePeak(axis);
+    if (axis == "x") m.amplitude = 0.10;
+    else if (axis == "y") { m.amplitude = 0.045; m.offset = -0.015; }
+    else if (axis == "z") { m.amplitude = 0.04; m.offset = 0.01; }
+    else m.amplitude = 0.15;  // rad, the three rotations
+    m.frequency = peak / (2.0 * M_PI * m.amplitude);
+    m.start = 1.5;
+    m.duration = 4.0;
+    char d[160];
+    std::snprintf(d, sizeof(d), "right skateboard along %s: amplitude %g %s at %.2f Hz (peak %.2f %s), left locked",
+                  axis.c_str(), m.amplitude, axis.size() == 1 ? "m" : "rad", m.frequency, peak,
+                  axis.size() == 1 ? "m/s" : "rad/s");
+    p.description = d;
+    p.run.duration = m.start + m.duration + 1.5;
+  } else if (name == "skate_mixed") {
+    // Both boards inclined differently and translating back and forth out of phase, with 8 N·s
+    // pushes along +Y and -Y while they move.
+    // The amplitude is what this controller survives with the pushes (0.10 m/s peak per board;
+    // 0.03 m falls after the second push, 0.05 m without pushes passes; docs/scenarios.md).
+    p.description = "both skateboards inclined (left pitch +3 deg, right roll -3 deg), X out of phase "
+                    "(0.02 m, 0.8 Hz), 8 N·s pushes along +Y at 4 s and -Y at 7 s";
+    p.scene = "scene_skateboards.xml";
+    const double incl = 3.0 * M_PI / 180.0;
+    for (const char* side : {"l", "r"}) {
+      SupportMotion& m = motionOf(p, std::string(side) + "_board_x");
+      m.amplitude = 0.02;
+      m.frequency = 0.8;
+      m.start = 1.5;
+      m.duration = 8.0;
+      m.phase = side[0] == 'l' ? 0.0 : M_PI;
+      SupportMotion& t = motionOf(p, std::string(side) + "_board_" + (side[0] == 'l' ? "pitch" : "roll"));
+      t.offset = side[0] == 'l' ? incl : -incl;
+      t.frequency = 0.0;
+      t.start = 1.0;
+      t.duration = 9.0;
+      t.ramp = 1.0;
+    }
+    p.run.pushes = series(4.0, 3.0, {8}, Eigen::Vector3d::UnitY());
+    p.run.pushes.push_back(p.run.pushes.back());
+    p.run.pushes.back().time = 7.0;
+    p.run.pushes.back().impulse = Eigen::Vector3d(0.0, -8.0, 0.0);
+    p.run.duration = 11.0;
+  } else if (name == "skate_sweep") {
+    p.description = "largest right-board velocity survived along x, y, z, roll, pitch, yaw (bisection on the skate_* amplitude)";
+    p.sweep = true;
+    p.scene = "scene_skateboards.xml";
+    p.sweep_params.skate = true;
+    p.sweep_params.directions = {"x", "y", "z", "roll", "pitch", "yaw"};
+    p.sweep_params.min_impulse = 0.1;
+    p.sweep_params.max_impulse = 2.5;
+    p.sweep_params.resolution = 0.05;
+    p.sweep_params.required = 1.0;
+    p.run.duration = 7.0;
   } else if (name == "push_sweep") {
     p.description = "largest single impulse survived along +X, -X, +Y, -Y (bisection)";
     p.sweep = true;
@@ -343,6 +516,11 @@ RunOptions runOptions(const ScenarioParams& p) {
   for (Push& push : o.pushes) {
     push.ball = p.ball;
     push.duration = p.push_duration;
+  }
+  o.supports.clear();
+  for (const SupportMotion& m : p.supports) {
+    if (!m.active()) continue;
+    o.supports.push_back(m);
   }
   return o;
 }

@@ -8,11 +8,14 @@
 #include <vector>
 
 #include "run.hpp"
+#include "support_motion.hpp"
 
 namespace hqp::sim {
 
-// Bisection for the largest impulse survived along each direction (push_sweep).
+// Bisection for the largest impulse survived along each direction (push_sweep), or for the
+// largest board velocity along each axis (skate_sweep: values are fractions of the paper's peak).
 struct SweepParams {
+  bool skate = false;          // skate_sweep: directions are x, y, z, roll, pitch, yaw
   std::vector<std::string> directions = {"+x", "-x", "+y", "-y"};
   double min_impulse = 4.0;    // N·s, first bracket end (expected to pass)
   double max_impulse = 40.0;   // N·s, other end (expected to fail)
@@ -48,7 +51,19 @@ struct ScenarioParams {
   double kinematic_compensation = 1.0;    // factor on the YAML's k_q̇ (eq. 8)
   bool ablation = false;                  // friction_ablation: runs instead of one run
   AblationParams ablation_params;
+  // Moving supports (issue 6): the scene file (in the directory of the default scene.xml) and
+  // one motion per servo axis of kSupportAxes (amplitude 0 and offset 0: not driven).
+  std::string scene = "scene.xml";
+  std::vector<SupportMotion> supports;
+  double support_ramp = 0.5;      // s, ramp of motions set from text (motion_ramp also sets every existing one)
 };
+
+// The servo axes a scene may have (seesaw scenes: seesaw; skateboards: the rest).
+const std::vector<std::string>& supportAxes();
+// The paper's peak right-foot velocity for skate axis x, y, z (m/s), roll, pitch, yaw (rad/s).
+double paperSkatePeak(const std::string& axis);
+// The scene file of a scenario: p.scene next to `default_scene` (the build's scene.xml).
+std::string scenePath(const ScenarioParams& p, const std::string& default_scene);
 
 // The presets, in the order `--list` shows them.
 std::vector<std::string> scenarioNames();

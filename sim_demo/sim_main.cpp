@@ -67,7 +67,7 @@ std::vector<std::string> makePlots(const Paths& paths, const ScenarioParams& p, 
   }
   std::vector<std::string> files;
   const std::string stem = fs::path(csv).stem().string();
-  for (const char* fig : {"_fig8.png", "_fig9.png", "_fig13.png"}) {
+  for (const char* fig : {"_fig8.png", "_fig9.png", "_fig11.png", "_fig12.png", "_fig13.png", "_fig14.png"}) {
     const fs::path f = fs::path(dir) / (stem + fig);
     if (fs::exists(f)) files.push_back(f.string());
   }
@@ -85,7 +85,7 @@ std::unique_ptr<hqp::sim::Driver> makeDriver(const std::string& driver_name, con
 
 hqp::sim::SimulationOptions simulationOptions(const Paths& paths, const ScenarioParams& p) {
   hqp::sim::SimulationOptions so;
-  so.scene = paths.scene;
+  so.scene = hqp::sim::scenePath(p, paths.scene);  // moving supports bring their own scene
   so.plant = paths.plant;
   so.noise = p.noise;
   so.seed = p.seed;
@@ -162,7 +162,8 @@ int main(int argc, char** argv) {
     for (const std::string& n : hqp::sim::scenarioNames()) {
       std::printf("  %s:", n.c_str());
       for (const auto& [k, v] : hqp::sim::parameterValues(hqp::sim::presetScenario(n))) {
-        if (k == "duration" || k == "pushes") std::printf(" %s=%s", k.c_str(), v.c_str());
+        const bool support = (k == "scene" && v != "scene.xml") || (k.rfind("motion_", 0) == 0 && k != "motion_ramp" && v != "none");
+        if (k == "duration" || k == "pushes" || support) std::printf(" %s=%s", k.c_str(), v.c_str());
       }
       std::printf("\n");
     }
@@ -215,7 +216,8 @@ int main(int argc, char** argv) {
       nlohmann::ordered_json record;
       if (p.sweep) {
         const auto on_trial = [](const hqp::sim::SweepDirection& d, const hqp::sim::SweepTrial& t) {
-          std::printf("  %s %6.2f N·s: %s (max pitch %.1f deg, roll %.1f deg)%s%s\n", d.direction.c_str(), t.impulse,
+          std::printf("  %s %6.2f %s: %s (max pitch %.1f deg, roll %.1f deg)%s%s\n", d.direction.c_str(), t.impulse,
+                      d.unit.c_str(),
                       t.run.passed ? "pass" : "FAIL", t.run.max_abs_pitch * 180 / M_PI,
                       t.run.max_abs_roll * 180 / M_PI, t.run.fell ? ", fell: " : "", t.run.fall_reason.c_str());
           std::fflush(stdout);

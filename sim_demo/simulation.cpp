@@ -106,15 +106,23 @@ void Simulation::reset() {
   // Free joint: position, quaternion (w x y z, upright).
   double* base = d_->qpos + base_qadr_;
   base[0] = base[1] = 0.0;
-  base[2] = 1.0;
+  base[2] = 2.0;  // above every support, so the rays below start outside them
   base[3] = 1.0;
   base[4] = base[5] = base[6] = 0.0;
   for (int i = 0; i < kJoints; ++i) d_->qpos[qadr_[i]] = q_stand_[i];
   mj_kinematics(m_, d_);
-  // Lower the base until the lower sole touches z = 0.
-  double lowest = std::numeric_limits<double>::infinity();
-  for (int c = 0; c < kContacts; ++c) lowest = std::min(lowest, d_->xpos[3 * sole_body_[c] + 2]);
-  base[2] -= lowest;
+  // Lower the base until the first sole touches what is below it: a ray straight down from each
+  // sole origin (the plate's underside) to the first geom that is not that sole (the floor plane
+  // at z = 0 in scene.xml, a board top on moving supports).
+  double drop = std::numeric_limits<double>::infinity();
+  const mjtNum down[3] = {0.0, 0.0, -1.0};
+  for (int c = 0; c < kContacts; ++c) {
+    const double* p = d_->xpos + 3 * sole_body_[c];
+    int geom = -1;
+    const double dist = mj_ray(m_, d_, p, down, nullptr, 1, sole_body_[c], &geom);
+    drop = std::min(drop, dist >= 0.0 ? dist : p[2]);  // nothing below: land on z = 0
+  }
+  base[2] -= drop;
   for (int u = 0; u < m_->nu; ++u) d_->ctrl[u] = 0.0;
   ball_flying_ = false;  // mj_resetData parked the ball at its qpos0
   delivered_.setZero();
@@ -262,6 +270,40 @@ double Simulation::torsoPitch() const { return bodyPitch(d_, torso_); }
 double Simulation::torsoRoll() const { return bodyRoll(d_, torso_); }
 double Simulation::footPitch(int c) const { return bodyPitch(d_, sole_body_[c]); }
 double Simulation::footRoll(int c) const { return bodyRoll(d_, sole_body_[c]); }
+
+double Simulation::footYaw(int c) const {
+  const double* R = d_->xmat + 9 * sole_body_[c];
+  return std::atan2(R[3], R[0]);
+}
+
+Vector6 Simulation::footVelocity(int c) const {
+  mjtNum v[6];
+  mj_objectVelocity(m_, d_, mjOBJ_BODY, sole_body_[c], v, 0);  // [angular; linear], world axes
+  Vector6 out;
+  for (int k = 0; k < 6; ++k) out[k] = v[k];
+  return out;
+}
+
+int Simulation::supportActuator(const std::string& name) const {
+  const int a = requireId(m_, mjOBJ_ACTUATOR, name, "support actuator");
+  const int j = m_->actuator_trnid[2 * a];
+  if (m_->actuator_trntype[a] != mjTRN_JOINT || (m_->jnt_type[j] != mjJNT_HINGE && m_->jnt_type[j] != mjJNT_SLIDE) ||
+      !(m_->actuator_gainprm[mjNGAIN * a] > 0.0) || m_->actuator_biastype[a] != mjBIAS_AFFINE) {
+    throw std::runtime_error("actuator '" + name + "' is not a position servo on a hinge or slide joint");
+  }
+  for (int i = 0; i < kJoints; ++i) {
+    if (a == act_[i]) throw std::runtime_error("actuator '" + name + "' belongs to the robot");
+  }
+  return a;
+}
+
+void Simulation::setSupportTarget(int a, double q, double dq) {
+  const int j = m_->actuator_trnid[2 * a];
+  const double kp = m_->actuator_gainprm[mjNGAIN * a];
+  d_->ctrl[a] = q + m_->dof_damping[m_->jnt_dofadr[j]] / kp * dq;
+}
+
+double Simulation::supportPosition(int a) const { return d_->qpos[m_->jnt_qposadr[m_->actuator_trnid[2 * a]]]; }
 
 Eigen::Vector3d Simulation::centerOfMass() const {
   return Eigen::Vector3d(d_->subtree_com + 3 * torso_);  // the robot is the torso's subtree

@@ -44,7 +44,8 @@ class Simulation {
   Simulation(const Simulation&) = delete;
   Simulation& operator=(const Simulation&) = delete;
 
-  // Standing pose, torso upright, both soles on the floor, at rest, t = 0, zero command.
+  // Standing pose, torso upright, at rest, t = 0, zero command; the soles rest on whatever is
+  // below them (floor, seesaw, skateboards: found by a ray straight down from each sole).
   void reset();
   // SensorData from MuJoCo's sensors (encoders, IMU, F/T), plus noise if enabled. The values
   // belong to the current state with the previous command's torques (zero-order hold).
@@ -66,6 +67,14 @@ class Simulation {
   void launchBall(const Eigen::Vector3d& momentum, double distance = 0.6);
   Eigen::Vector3d ballMomentum() const;     // N·s, world (zero without a ball)
   bool ballTouchesRobot() const;
+
+  // Moving supports (seesaw, skateboards; scene <position> actuators on one-DoF joints, found by
+  // name; throws if there is none). The servo force is kp (ctrl - q) - damping q̇ (the joint's
+  // implicit damping), so ctrl = q* + (damping / kp) q̇* makes it kp (q* - q) + damping (q̇* - q̇):
+  // position servo with velocity feed-forward.
+  int supportActuator(const std::string& name) const;
+  void setSupportTarget(int actuator, double q, double dq);
+  double supportPosition(int actuator) const;  // the servo joint's position (m or rad)
 
   double time() const { return d_->time; }
   double controlDt() const { return options_.control_dt; }
@@ -89,6 +98,9 @@ class Simulation {
   Eigen::Vector3d centerOfMass() const;     // m, world
   double footPitch(int c) const;            // rad, sole plate about world y
   double footRoll(int c) const;             // rad, sole plate about world x
+  double footYaw(int c) const;              // rad, sole plate about world z
+  // Sole plate velocity at the sole origin, world axes: angular (rad/s), then linear (m/s).
+  Vector6 footVelocity(int c) const;
   // The sole plate's rectangle in the sole frame (x_min, y_min), (x_max, y_max), from the
   // scene's collision box: what the measured ZMP is checked against.
   const std::array<Eigen::Vector2d, 2>& soleRectangle(int c) const { return sole_rect_[c]; }

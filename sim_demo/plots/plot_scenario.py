@@ -6,6 +6,10 @@ Writes, for RUN.csv with stem S:
   DIR/S_fig9.png   measured vs optimized ZMP per foot in the sole frame, and the lowest-level
                    task error ||A x - b||^2 on a log axis (paper Fig. 9)
   DIR/S_fig13.png  controller compute time per tick and its histogram (paper Fig. 13)
+and for runs on moving supports (the CSV has support_<axis> columns, issue 6):
+  DIR/S_fig11.png  right-foot orientation and angular velocity, low-passed at 20 Hz (paper Fig. 11)
+  DIR/S_fig12.png  right-foot measured ZMP x and y in the sole frame (paper Fig. 12)
+  DIR/S_fig14.png  right-foot linear and angular velocity, low-passed at 20 Hz (paper Fig. 14)
 
 Every column except `time` is optional: what is missing is drawn as a "not logged" panel.
 Needs only numpy and matplotlib (Agg).
@@ -543,6 +547,113 @@ def fig13(run, out, title, pushes, fall_time):
     finish(fig, out)
 
 
+# ---- Fig. 11, 12, 14: moving supports ---------------------------------------------------------------
+
+FOOT_VELOCITY_CUTOFF_HZ = 20.0  # the paper low-passes the foot's angular velocity at 20 Hz
+
+
+def low_pass(t, y, cutoff_hz=FOOT_VELOCITY_CUTOFF_HZ):
+    """First-order low-pass (the run's own peak metric uses the same filter); NaN rows hold."""
+    out = np.array(y, dtype=float)
+    if len(out) < 2:
+        return out
+    dt = float(np.median(np.diff(t))) if len(t) > 1 else 1e-3
+    a = dt / (dt + 1.0 / (2.0 * math.pi * cutoff_hz))
+    acc = 0.0
+    for i, v in enumerate(out):
+        if np.isfinite(v):
+            acc += a * (v - acc)
+        out[i] = acc
+    return out
+
+
+def support_columns(run):
+    return [n for n in run.names if n.startswith("support_")]
+
+
+def plot_components(ax, run, names, labels, colors, scale, unit, fall_time, pushes):
+    """Low-passed components with each one's peak |value| in the legend label."""
+    t = run.t
+    any_col = False
+    for n, lab, c in zip(names, labels, colors):
+        y = run.col(n)
+        if y is None:
+            continue
+        any_col = True
+        f = low_pass(t, y) * scale
+        peak = float(np.nanmax(np.abs(f))) if np.any(np.isfinite(f)) else float("nan")
+        plot_line(ax, t, f, color=c, lw=0.9, label=f"{lab} (peak {peak:.2f} {unit})")
+    if not any_col:
+        not_logged(ax, ", ".join(names))
+    mark_events(ax, pushes, fall_time)
+    ax.grid(True, alpha=0.3)
+    side_legend(ax)
+
+
+def fig11(run, out, title, pushes, fall_time):
+    fig, axes = plt.subplots(2, 1, figsize=(11, 6.5), sharex=True)
+    time_axis(axes[0], run, fall_time)
+    deg = 180.0 / math.pi
+    ax = axes[0]
+    for n, lab, c in (("r_foot_roll", "roll (about X)", "tab:blue"), ("r_foot_pitch", "pitch (about Y)", "tab:orange"),
+                      ("r_foot_yaw", "yaw (about Z)", "tab:green")):
+        y = run.col(n)
+        if y is not None:
+            y0 = run.first(n)
+            plot_angle(ax, run.t, (y - y0) * deg, c, lab, "max {:.2f}° at {:.2f} s")
+    ax.set_ylabel("right foot angle (°)\nrelative to t = 0")
+    mark_events(ax, pushes, fall_time)
+    ax.grid(True, alpha=0.3)
+    side_legend(ax)
+    plot_components(axes[1], run, ["r_foot_wx", "r_foot_wy", "r_foot_wz"], ["ω x", "ω y", "ω z"],
+                    ["tab:blue", "tab:orange", "tab:green"], 1.0, "rad/s", fall_time, pushes)
+    axes[1].set_ylabel("angular velocity (rad/s)\n20 Hz low-pass")
+    axes[1].set_xlabel("time (s)")
+    suptitle(fig, title, "right foot orientation and angular velocity (Fig. 11)", run, fall_time)
+    fig.tight_layout()
+    finish(fig, out)
+
+
+def fig12(run, out, title, pushes, fall_time, sole_x, sole_y):
+    fig, axes = plt.subplots(2, 1, figsize=(11, 6.5), sharex=True)
+    time_axis(axes[0], run, fall_time)
+    zmp_panel(axes[0], run, "r", "x", sole_x, pushes, fall_time)
+    zmp_panel(axes[1], run, "r", "y", sole_y, pushes, fall_time)
+    for ax in axes:
+        side_legend(ax)
+    axes[1].set_xlabel("time (s)")
+    suptitle(fig, title, "right foot ZMP (Fig. 12)", run, fall_time)
+    fig.tight_layout()
+    finish(fig, out)
+
+
+def fig14(run, out, title, pushes, fall_time):
+    fig, axes = plt.subplots(3, 1, figsize=(11, 8.5), sharex=True)
+    time_axis(axes[0], run, fall_time)
+    plot_components(axes[0], run, ["r_foot_vx", "r_foot_vy", "r_foot_vz"], ["v x", "v y", "v z"],
+                    ["tab:blue", "tab:orange", "tab:green"], 1.0, "m/s", fall_time, pushes)
+    axes[0].set_ylabel("right foot velocity (m/s)\n20 Hz low-pass")
+    plot_components(axes[1], run, ["r_foot_wx", "r_foot_wy", "r_foot_wz"], ["ω x", "ω y", "ω z"],
+                    ["tab:blue", "tab:orange", "tab:green"], 1.0, "rad/s", fall_time, pushes)
+    axes[1].set_ylabel("right foot angular\nvelocity (rad/s)")
+    ax = axes[2]
+    cols = support_columns(run)
+    if not cols:
+        not_logged(ax, "support_<axis>")
+    for n in cols:
+        y = run.col(n)
+        unit = "m" if n.endswith(("_x", "_y", "_z")) else "rad"
+        plot_line(ax, run.t, y, lw=0.9, label=f"{n[len('support_'):]} ({unit})")
+    mark_events(ax, pushes, fall_time)
+    ax.set_ylabel("support servo\nposition (m or rad)")
+    ax.set_xlabel("time (s)")
+    ax.grid(True, alpha=0.3)
+    side_legend(ax)
+    suptitle(fig, title, "right foot velocity on the moving support (Fig. 14)", run, fall_time)
+    fig.tight_layout()
+    finish(fig, out)
+
+
 # ---- command line ---------------------------------------------------------------------------------
 
 def read_summary(path, csv_path, stem):
@@ -590,7 +701,7 @@ def parse_pushes(text):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description="Plots (paper Fig. 8, 9, 13) of one sim_demo CSV log.")
+    ap = argparse.ArgumentParser(description="Plots (paper Fig. 8, 9, 13; 11, 12, 14 on moving supports) of one sim_demo CSV log.")
     ap.add_argument("csv", help="the run's CSV log (sim_demo --out DIR writes DIR/<scenario>/<scenario>.csv)")
     ap.add_argument("--out", required=True, help="output directory for the PNGs")
     ap.add_argument("--title", help="figure title (default: the CSV's stem)")
@@ -653,6 +764,10 @@ def main(argv=None):
     fig8(run, os.path.join(a.out, f"{stem}{suffix}_fig8.png"), title, pushes, fall_time)
     fig9(run, os.path.join(a.out, f"{stem}{suffix}_fig9.png"), title, pushes, fall_time, a.sole_x, a.sole_y)
     fig13(run, os.path.join(a.out, f"{stem}{suffix}_fig13.png"), title, pushes, fall_time)
+    if support_columns(run):
+        fig11(run, os.path.join(a.out, f"{stem}{suffix}_fig11.png"), title, pushes, fall_time)
+        fig12(run, os.path.join(a.out, f"{stem}{suffix}_fig12.png"), title, pushes, fall_time, a.sole_x, a.sole_y)
+        fig14(run, os.path.join(a.out, f"{stem}{suffix}_fig14.png"), title, pushes, fall_time)
     return 0
 
 

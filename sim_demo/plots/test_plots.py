@@ -129,6 +129,26 @@ def falling_run(path):
     write_csv(path, c, partial_tail="2.3010,0.0001,0.00")
 
 
+def support_run(path):
+    """4 s on a moving support: the right foot rides a board along x (0.5 m/s peak at 1.5 Hz) with
+    200 Hz chatter on its angular velocity; support_r_board_x is the board's position."""
+    t = np.round(np.arange(0, 4.0, 0.001), 4)
+    c = base_columns(t)
+    for f in ("l", "r"):
+        c[f + "_foot_pitch"] = np.zeros_like(t)
+        c[f + "_foot_roll"] = np.zeros_like(t)
+    c["l_foot_yaw"] = np.zeros_like(t)
+    c["r_foot_yaw"] = 0.01 * np.sin(t)
+    om = 2 * np.pi * 1.5
+    for f in ("l", "r"):
+        for k in ("wx", "wy", "wz", "vx", "vy", "vz"):
+            c[f"{f}_foot_{k}"] = np.zeros_like(t)
+    c["r_foot_vx"] = 0.5 * np.cos(om * t)
+    c["r_foot_wy"] = 0.3 * np.sin(2 * np.pi * 200.0 * t)
+    c["support_r_board_x"] = 0.5 / om * np.sin(om * t)
+    write_csv(path, c)
+
+
 def read_png_size(path):
     with open(path, "rb") as f:
         head = f.read(24)
@@ -137,8 +157,8 @@ def read_png_size(path):
     return struct.unpack(">II", head[16:24])
 
 
-def check_pngs(outdir, stem):
-    for fig in ("fig8", "fig9", "fig13"):
+def check_pngs(outdir, stem, figs=("fig8", "fig9", "fig13")):
+    for fig in figs:
         p = os.path.join(outdir, f"{stem}_{fig}.png")
         ok = os.path.isfile(p)
         check(ok, f"{stem}_{fig}.png exists")
@@ -235,6 +255,23 @@ def test_plots(tmp):
     check(len(pushes) == 1 and abs(pushes[0][0] - 0.8) < 1e-9 and "+12 N·s" in pushes[0][1],
           f"ball launch found at 0.8 s with 12 N·s: {pushes}")
     check(abs(plot_scenario.detect_fall(run) - 2.3) < 1e-9, "fall detected at the last row (2.3 s)")
+
+    # Moving supports: Fig. 11, 12, 14 only for runs with support_ columns; the 20 Hz low-pass
+    # against its closed-form gain 1 / sqrt(1 + (f / 20)^2).
+    skate = os.path.join(tmp, "skate_x.csv")
+    support_run(skate)
+    r = run_inprocess(plot_scenario.main, [skate, "--out", out])
+    check(r.returncode == 0, "plot_scenario on a moving-support run exits 0", r)
+    check_pngs(out, "skate_x", ("fig8", "fig9", "fig11", "fig12", "fig13", "fig14"))
+    check(not os.path.exists(os.path.join(out, "push_x_fig14.png")), "push runs get no Fig. 14")
+    run = plot_scenario.Run(skate)
+    lp = plot_scenario.low_pass(run.t, run.col("r_foot_vx"))
+    g = 1.0 / np.sqrt(1.0 + (1.5 / 20.0) ** 2)
+    check(abs(np.max(np.abs(lp[1000:])) - 0.5 * g) < 0.005, f"1.5 Hz passes the 20 Hz low-pass ({np.max(np.abs(lp[1000:])):.4f})")
+    lp = plot_scenario.low_pass(run.t, run.col("r_foot_wy"))
+    g = 1.0 / np.sqrt(1.0 + (200.0 / 20.0) ** 2)
+    check(abs(np.max(np.abs(lp[1000:])) - 0.3 * g) < 0.1 * 0.3 * g,
+          f"200 Hz chatter is cut to 1/10 ({np.max(np.abs(lp[1000:])):.4f} vs {0.3 * g:.4f})")
 
     # Decimation keeps every extreme and NaN gaps.
     t = np.arange(60000) * 1e-3
