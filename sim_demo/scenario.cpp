@@ -399,15 +399,15 @@ ScenarioParams presetScenario(const std::string& name) {
   } else if (name == "skate_mixed") {
     // Both boards inclined differently and translating back and forth out of phase, with 8 N·s
     // pushes along +Y and -Y while they move.
-    // The amplitude is what this controller survives with the pushes (0.10 m/s peak per board;
-    // 0.03 m falls after the second push, 0.05 m without pushes passes; docs/scenarios.md).
+    // 0.1 m at 0.8 Hz: 0.50 m/s peak per board, 1 m/s between them (0.15 m falls after the
+    // second push; docs/scenarios.md).
     p.description = "both skateboards inclined (left pitch +3 deg, right roll -3 deg), X out of phase "
-                    "(0.02 m, 0.8 Hz), 8 N·s pushes along +Y at 4 s and -Y at 7 s";
+                    "(0.1 m, 0.8 Hz), 8 N·s pushes along +Y at 4 s and -Y at 7 s";
     p.scene = "scene_skateboards.xml";
     const double incl = 3.0 * M_PI / 180.0;
     for (const char* side : {"l", "r"}) {
       SupportMotion& m = motionOf(p, std::string(side) + "_board_x");
-      m.amplitude = 0.02;
+      m.amplitude = 0.1;
       m.frequency = 0.8;
       m.start = 1.5;
       m.duration = 8.0;

@@ -56,7 +56,7 @@ class Controller {
         hqp_(hqpSettings(config)),
         wqp_(QpSettings{}, config.wqp_priority_ratio) {
     estimator_.configure(config_.estimator);
-    planner_.configure(config_.planner, Robot::total_mass);
+    planner_.configure(config_.planner, Robot::total_mass, config_.dt);
     joint_.configure(config_.joint);
     configureHierarchy(hqp_, config_.balance);
     configureHierarchy(wqp_, config_.balance);

@@ -92,6 +92,14 @@ class ConfigReader {
     return x;
   }
 
+  bool boolean(const YAML::Node& parent, const std::string& path, const std::string& key) const {
+    const std::string full = join(path, key);
+    const YAML::Node n = child(parent, path, key);
+    bool b = false;
+    if (!n.IsScalar() || !YAML::convert<bool>::decode(n, b)) fail("'" + full + "' must be true or false");
+    return b;
+  }
+
   double finite(const YAML::Node& parent, const std::string& path, const std::string& key) const {
     const std::string full = join(path, key);
     const double x = number(child(parent, path, key), full);
@@ -213,7 +221,8 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
   }
   {
     const std::string p = "planner";
-    const YAML::Node n = r.map(root, "", p, {"safe_margin", "com_height", "sole", "torso_yaw_offset"});
+    const YAML::Node n = r.map(root, "", p, {"safe_margin", "com_height", "sole", "torso_yaw_offset",
+                                            "follow_acceleration_cutoff", "follow_translation"});
     PlannerParameters& pl = c.planner;
     pl.safe_margin = r.atLeast(n, p, "safe_margin", 0.0, false);
     pl.com_height = r.finite(n, p, "com_height");
@@ -223,6 +232,10 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
       r.fail("'planner.safe_margin' leaves no safe region inside 'planner.sole'");
     }
     pl.torso_yaw_offset = r.finite(n, p, "torso_yaw_offset");
+    // Moving-support extensions: optional, off (the paper's rule) when absent.
+    if (n["follow_acceleration_cutoff"])
+      pl.follow_acceleration_cutoff = r.atLeast(n, p, "follow_acceleration_cutoff", 0.0, false);
+    if (n["follow_translation"]) pl.follow_translation = r.boolean(n, p, "follow_translation");
   }
   {
     const YAML::Node n = r.map(root, "", "estimator", {"contact_threshold"});

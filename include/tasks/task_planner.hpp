@@ -8,6 +8,15 @@
 //   Torso: upright (r_T,ref = 0 in the paper), turned to the mean heading of the feet so that
 //   a robot standing turned in the world is not asked to yaw; zero angular velocity.
 //   Forces: F_ref = [0, 0, m g / NC, 0, 0, 0] per contact.
+// Two extensions for moving supports (docs/tasks.md, "Moving supports"; both off by default,
+// which is the paper's rule exactly):
+//   follow_acceleration_cutoff > 0: a following foot also gets the feed-forward acceleration
+//     a_F,ref = low-pass(d v_F / dt), so that q̈* (and ∫q̈* dt of eq. 8) carries the motion the
+//     support imposes instead of planning the foot to stop;
+//   follow_translation: a foot in contact whose ZMP left the safe region keeps its orientation
+//     reference (the paper's hold, which stops a tipping foot) but its position, velocity and
+//     feed-forward acceleration references follow the foot's translation, so a board that
+//     carries the foot away is not fought by the level-2 task.
 // Allocation-free and exception-free; see docs/tasks.md.
 
 #include <array>
@@ -31,14 +40,23 @@ struct PlannerParameters {
   // Yaw of the torso frame relative to the feet's heading when the robot stands straight
   // (0 for Walker3's imu frame; π/2 for the quadruped's imu frame).
   double torso_yaw_offset = 0.0;
+  // Hz, cutoff of the first-order low-pass on the finite difference of a foot's measured
+  // velocity that feeds a following foot's acceleration reference; 0 = no feed-forward (paper).
+  double follow_acceleration_cutoff = 0.0;
+  // A foot whose ZMP left the safe region holds only its orientation; its translation follows.
+  bool follow_translation = false;
 };
 
 template <int NC>
 class TaskPlanner {
  public:
-  void configure(const PlannerParameters& p, double total_mass) {
+  // dt: the control period (s), for the finite difference of the feet's velocities.
+  void configure(const PlannerParameters& p, double total_mass, double dt = 0.001) {
     params_ = p;
     mass_ = total_mass;
+    dt_ = dt;
+    const double fc = p.follow_acceleration_cutoff;
+    alpha_ = (fc > 0.0 && dt > 0.0) ? -std::expm1(-2.0 * kPi * fc * dt) : 0.0;
     reset();
   }
 
@@ -46,6 +64,11 @@ class TaskPlanner {
   void reset() {
     initialized_ = false;
     safe_.fill(false);
+    have_velocity_.fill(false);
+    for (int c = 0; c < NC; ++c) {
+      velocity_[c].setZero();
+      acceleration_[c].setZero();
+    }
   }
 
   // cop[c]: measured ZMP of foot c in its sole frame (x, y); in_contact[c]: the estimator's flag.
@@ -55,14 +78,26 @@ class TaskPlanner {
     if (!initialized_) initialize(dyn, refs);
 
     for (int c = 0; c < NC; ++c) {
+      const Vector6 v = dyn.velocity(c);
+      if (alpha_ > 0.0) {  // a_F ≈ low-pass((v_k − v_{k−1}) / dt); the first tick has no difference
+        if (have_velocity_[c]) acceleration_[c] += alpha_ * ((v - velocity_[c]) / dt_ - acceleration_[c]);
+        velocity_[c] = v;
+        have_velocity_[c] = true;
+      }
       safe_[c] = in_contact[c] && insideSafeRegion(cop[c]);
+      refs.contact_acceleration[c].setZero();
       if (safe_[c]) {
         refs.contact_pose[c] = dyn.placement(c);
-        refs.contact_velocity[c] = dyn.velocity(c);
+        refs.contact_velocity[c] = v;
+        refs.contact_acceleration[c] = acceleration_[c];
+      } else if (params_.follow_translation && in_contact[c]) {
+        // Orientation held (previous reference, zero angular velocity); translation followed.
+        refs.contact_pose[c].translation() = dyn.placement(c).translation();
+        refs.contact_velocity[c] << v.template head<3>(), Eigen::Vector3d::Zero();
+        refs.contact_acceleration[c].template head<3>() = acceleration_[c].template head<3>();
       } else {
         refs.contact_velocity[c].setZero();  // hold the previous pose
       }
-      refs.contact_acceleration[c].setZero();
     }
 
     // CoM: midpoint of the feet plus C, mean foot velocity.
@@ -120,8 +155,14 @@ class TaskPlanner {
     initialized_ = true;
   }
 
+  static constexpr double kPi = 3.14159265358979323846;
+
   PlannerParameters params_{};
   double mass_ = 0.0;
+  double dt_ = 0.001;
+  double alpha_ = 0.0;  // low-pass gain per tick, 1 − exp(−2π f_c dt)
+  std::array<bool, NC> have_velocity_{};
+  std::array<Vector6, NC> velocity_{}, acceleration_{};  // last measured v_F, filtered a_F
   double com_height_ = 0.0;
   bool initialized_ = false;
   std::array<bool, NC> safe_{};

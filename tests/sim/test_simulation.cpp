@@ -551,26 +551,26 @@ TEST(SimSupports, SolesLandOnTheSupportsAndTheServosTrack) {
   }
 }
 
-// The paper's seesaw about Y (Sec. VI-B, Fig. 11-12) at half its peak angular velocity: +-6 deg
-// at 0.78 Hz (0.51 rad/s; the full 1.02 rad/s preset falls with controller.yaml, docs/scenarios.md).
+// The paper's seesaw about Y (Sec. VI-B, Fig. 11-12) at its peak rate: +-6 deg at 1.55 Hz
+// (1.02 rad/s), the motion starting at 1 s.
 TEST(SimController, BalancesOnTheSeesawAboutYForThreeSeconds) {
   if (!hqp::sim::balanceControllerAvailable()) GTEST_SKIP() << "built without the balance controller";
-  const hqp::sim::RunSummary r = runPreset("seesaw_y", {"duration=3", "motion_seesaw=0.10472:0.78:1.0:6"});
+  const hqp::sim::RunSummary r = runPreset("seesaw_y", {"duration=3", "motion_seesaw=0.10472:1.55:1.0:6"});
   expectPassed(r, 3.0);
   // The soles followed the board (MuJoCo's own foot velocity and angle, closed-form profile):
-  // 6 deg and 0.51 rad/s about Y, nothing about X.
+  // 6 deg and 1.02 rad/s about Y, nothing about X.
   EXPECT_NEAR(r.max_abs_foot_pitch[1], 0.10472, 0.01);
-  EXPECT_GT(r.foot_angular_velocity_peak[1].y(), 0.95 * 0.10472 * 2 * M_PI * 0.78);
+  EXPECT_GT(r.foot_angular_velocity_peak[1].y(), 0.95 * 0.10472 * 2 * M_PI * 1.55);
   EXPECT_LT(r.foot_angular_velocity_peak[1].x(), 0.02);
 }
 
-// The right skateboard along X (Sec. VI-C, Fig. 14) at a quarter of the paper's 0.94 m/s
-// (0.025 m at 1.5 Hz): the largest rate this controller survives is ~0.27 m/s (skate_sweep).
+// The right skateboard along X (Sec. VI-C, Fig. 14) at half the paper's 0.94 m/s (0.05 m at
+// 1.5 Hz, 0.47 m/s), the motion starting at 1 s.
 TEST(SimController, StandsOnTheRightSkateboardMovingAlongXForThreeSeconds) {
   if (!hqp::sim::balanceControllerAvailable()) GTEST_SKIP() << "built without the balance controller";
-  const hqp::sim::RunSummary r = runPreset("skate_x", {"duration=3", "motion_r_board_x=0.025:1.5:1.0:4"});
+  const hqp::sim::RunSummary r = runPreset("skate_x", {"duration=3", "motion_r_board_x=0.05:1.5:1.0:4"});
   expectPassed(r, 3.0);
-  const double commanded = 0.025 * 2 * M_PI * 1.5;
+  const double commanded = 0.05 * 2 * M_PI * 1.5;
   EXPECT_NEAR(r.foot_linear_velocity_peak[1].x(), commanded, 0.1 * commanded) << "the right foot rides its board";
   EXPECT_LT(r.foot_linear_velocity_peak[0].x(), 0.05) << "the left board is locked";
 }

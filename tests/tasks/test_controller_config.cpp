@@ -172,6 +172,22 @@ TEST(ControllerConfig, NegativeOrInvalidValuesAreRejected) {
   expectRejected("    l_knee:         250", "    l_knee:         300", "balance.torque_limit.l_knee");
   expectRejected("x_min: -0.10, x_max: 0.10", "x_min: 0.10, x_max: -0.10", "balance.cop_region");
   expectRejected("  mu: 0.6", "  mu: .nan", "balance.mu");
+  expectRejected("  follow_acceleration_cutoff: 20", "  follow_acceleration_cutoff: -1",
+                 "planner.follow_acceleration_cutoff");
+  expectRejected("  follow_translation: true", "  follow_translation: maybe", "planner.follow_translation");
+}
+
+// The moving-support options are optional; without them the planner is the paper's rule.
+TEST(ControllerConfig, MovingSupportOptionsDefaultToThePaperRule) {
+  const Config shipped = hqp::tasks::loadControllerConfig<Robot>(kYaml);
+  EXPECT_EQ(shipped.planner.follow_acceleration_cutoff, 20.0);
+  EXPECT_TRUE(shipped.planner.follow_translation);
+  EditedConfig f("  follow_acceleration_cutoff: 20", "  # (removed)");
+  ASSERT_TRUE(f.found());
+  EditedConfig g("  follow_translation: true", "  # (removed)");
+  ASSERT_TRUE(g.found());
+  EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(f.path()).planner.follow_acceleration_cutoff, 0.0);
+  EXPECT_FALSE(hqp::tasks::loadControllerConfig<Robot>(g.path()).planner.follow_translation);
 }
 
 TEST(ControllerConfig, OtherSolverAndInfiniteLeakLoad) {

@@ -214,3 +214,55 @@ TEST_F(Planner, ResetReinitialisesFromTheState) {
 }
 
 }  // namespace
+
+// Moving-support extensions (docs/tasks.md "Moving supports"): a foot whose ZMP left the safe
+// region keeps following its translation but holds its orientation.
+TEST_F(Planner, FollowTranslationHoldsOnlyTheOrientation) {
+  params.follow_translation = true;
+  planner.configure(params, Robot::total_mass);
+  at(crouch());
+  step(centre);
+  // The whole robot turned by 0.2 rad, moved 5 cm and translating at v: left ZMP outside.
+  VectorV v = VectorV::Zero();
+  v.head<3>() << 0.1, -0.2, 0.05;
+  at(crouch(0.05, 0.0, 0.2), v);
+  step({Eigen::Vector2d(0.095, 0.0), Eigen::Vector2d::Zero()});
+  EXPECT_FALSE(planner.inSafeRegion(0));
+  EXPECT_LT((refs.contact_pose[0].translation() - dyn.placement(0).translation()).norm(), 1e-12);
+  EXPECT_TRUE(refs.contact_pose[0].linear().isIdentity(1e-12)) << "orientation held at the start pose";
+  EXPECT_LT((refs.contact_velocity[0].head<3>() - dyn.velocity(0).head<3>()).norm(), 1e-12);
+  EXPECT_TRUE(refs.contact_velocity[0].tail<3>().isZero(0.0));
+  // The right foot follows everything, as in the paper.
+  EXPECT_TRUE(refs.contact_pose[1].matrix().isApprox(dyn.placement(1).matrix(), 1e-12));
+  // Out of contact, the whole pose is held even with the option.
+  const Eigen::Vector3d held = refs.contact_pose[0].translation();
+  at(crouch(0.1, 0.0, 0.2), v);
+  step(centre, {false, true});
+  EXPECT_LT((refs.contact_pose[0].translation() - held).norm(), 1e-12);
+  EXPECT_TRUE(refs.contact_velocity[0].isZero(0.0));
+}
+
+// A following foot gets the low-passed finite difference of its velocity as feed-forward
+// acceleration: for a constant acceleration a the filter (gain α = 1 − exp(−2π f_c dt) per
+// tick) gives a (1 − (1 − α)^n) after n differences.
+TEST_F(Planner, FeedForwardAccelerationOfAFollowingFoot) {
+  const double fc = 20.0, dt = 0.001, a = 2.0;
+  params.follow_acceleration_cutoff = fc;
+  planner.configure(params, Robot::total_mass, dt);
+  const double alpha = 1.0 - std::exp(-2.0 * M_PI * fc * dt);
+  VectorV v = VectorV::Zero();
+  for (int k = 0; k <= 50; ++k) {
+    v(0) = a * k * dt;  // the robot translates rigidly along x with acceleration a
+    at(crouch(0.5 * a * k * dt * k * dt), v);
+    step(centre);
+    const double expected = a * (1.0 - std::pow(1.0 - alpha, k));
+    for (int c = 0; c < 2; ++c) {
+      EXPECT_NEAR(refs.contact_acceleration[c](0), expected, 1e-9) << "tick " << k;
+      EXPECT_NEAR(refs.contact_acceleration[c].tail<5>().norm(), 0.0, 1e-9);
+    }
+  }
+  // A held foot gets no feed-forward.
+  step({Eigen::Vector2d(0.1, 0.0), Eigen::Vector2d::Zero()});
+  EXPECT_TRUE(refs.contact_acceleration[0].isZero(0.0));
+  EXPECT_GT(refs.contact_acceleration[1](0), 0.5 * a);
+}
