@@ -1,12 +1,17 @@
 // The balance controller (include/tasks/controller.hpp) as the simulation's driver. The only
 // translation unit of sim_demo that instantiates the hierarchy (it is expensive to compile).
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
+#include "hqp/problem_file.hpp"
+#include "hqp/problem_instance.hpp"
+#include "recording.hpp"
 #include "run.hpp"
 #include "tasks/contact_layout.hpp"
 #include "tasks/controller.hpp"
@@ -28,8 +33,28 @@ class BalanceDriver final : public Driver {
         name_(config.solver == hqp::tasks::ControllerConfig<kJoints>::Solver::Hqp ? "balance controller (HQP)"
                                                                                     : "balance controller (WQP)") {}
   const char* name() const override { return name_; }
-  void reset() override { controller_->reset(); }
-  void tick(const Sensors& s, Command& cmd) override { controller_->tick(s, cmd); }
+  void reset() override {
+    controller_->reset();
+    tick_ = 0;
+    used_ = 0;
+  }
+  void tick(const Sensors& s, Command& cmd) override {
+    // Recording (docs/recording.md): the incoming working sets before the tick, the problem
+    // and its result after it, into the preallocated buffer (fixed-size copies, no heap).
+    const bool rec = used_ < buffer_.size() && tick_ >= rec_first_ && tick_ < rec_end_ &&
+                     (tick_ - rec_first_) % rec_every_ == 0;
+    if (rec) hqp::captureWarmStart(controller_->hqp(), buffer_[used_]);
+    controller_->tick(s, cmd);
+    // The solve stage's clock is set only on ticks that reached the solver (not in safe mode).
+    const auto& d = controller_->diagnostics();
+    if (rec && d.time_us[static_cast<int>(hqp::tasks::Stage::Solve)] > 0.0) {
+      auto& in = buffer_[used_++];
+      hqp::captureProblem(controller_->hqp(), in);
+      in.tick = tick_;
+      in.time = static_cast<double>(tick_) * controller_->config().dt;
+    }
+    ++tick_;
+  }
   bool safeMode() const override {
     return controller_->diagnostics().mode == hqp::tasks::ControllerMode::Safe;
   }
@@ -78,9 +103,34 @@ class BalanceDriver final : public Driver {
                  d.torso_error.x(), d.torso_error.y(), d.torso_error.z(), d.current_saturated ? 1 : 0);
   }
 
+  bool startRecording(const RecordOptions& o) {
+    if (controller_->config().solver != hqp::tasks::ControllerConfig<kJoints>::Solver::Hqp) return false;
+    if (o.every < 1 || o.duration <= 0.0 || o.start < 0.0) throw std::runtime_error("--record: bad window");
+    const double dt = controller_->config().dt;
+    rec_ = o;
+    rec_first_ = std::lround(o.start / dt);
+    rec_every_ = o.every;
+    const long ticks = std::lround(o.duration / dt);
+    rec_end_ = rec_first_ + ticks;
+    buffer_.assign(static_cast<std::size_t>((ticks + o.every - 1) / o.every), Instance{});  // ~19 kB each
+    used_ = 0;
+    return true;
+  }
+  std::size_t finishRecording() const {
+    if (rec_.file.empty()) return 0;
+    hqp::writeProblemFile<BalanceController::Hqp>(rec_.file, buffer_.data(), used_, controller_->hqp().settings(),
+                                                  rec_.source);
+    return used_;
+  }
+
  private:
+  using Instance = hqp::ProblemInstance<BalanceController::Hqp>;
   std::unique_ptr<BalanceController> controller_;  // large: keep it off the stack
   const char* name_;
+  std::vector<Instance> buffer_;  // sized by startRecording(), before the run
+  std::size_t used_ = 0;
+  long tick_ = 0, rec_first_ = 0, rec_end_ = 0, rec_every_ = 1;
+  RecordOptions rec_;
 };
 
 }  // namespace
@@ -106,5 +156,15 @@ std::unique_ptr<Driver> makeBalanceController(const std::string& config_path, bo
 }
 
 bool balanceControllerAvailable() { return true; }
+
+bool startRecording(Driver& driver, const RecordOptions& options) {
+  auto* d = dynamic_cast<BalanceDriver*>(&driver);
+  return d != nullptr && d->startRecording(options);
+}
+
+std::size_t finishRecording(Driver& driver) {
+  auto* d = dynamic_cast<BalanceDriver*>(&driver);
+  return d != nullptr ? d->finishRecording() : 0;
+}
 
 }  // namespace hqp::sim

@@ -4,6 +4,7 @@
 //   sim_demo --scenario NAME [--scenario NAME ...] [--set key=value ...] [--config FILE.yaml]
 //            [--out DIR] [--no-video] [--no-plots] [--controller hqp|wqp]
 //   sim_demo --all
+//   sim_demo --scenario NAME --record FILE [--record-start S] [--record-duration S] [--record-every N]
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -16,6 +17,7 @@
 
 #include "friction_ablation.hpp"
 #include "push_sweep.hpp"
+#include "recording.hpp"
 #include "report.hpp"
 #include "run.hpp"
 #include "scenario.hpp"
@@ -149,7 +151,14 @@ int main(int argc, char** argv) {
   app.add_option("--scene", paths.scene, "scene MJCF")->capture_default_str();
   app.add_option("--plant", paths.plant, "plant parameter YAML")->capture_default_str();
   app.add_option("--controller-config", paths.controller_config, "controller YAML")->capture_default_str();
+  hqp::sim::RecordOptions recording;
+  app.add_option("--record", recording.file, "record the HQP problem of the ticks in a window to FILE (docs/recording.md)");
+  app.add_option("--record-start", recording.start, "s, start of the recorded window")->capture_default_str();
+  app.add_option("--record-duration", recording.duration, "s, length of the recorded window")->capture_default_str();
+  app.add_option("--record-every", recording.every, "keep every Nth tick of the window")
+      ->check(CLI::PositiveNumber)->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  for (int i = 0; i < argc; ++i) recording.source += std::string(i ? " " : "") + argv[i];
 
   if (list) {
     std::printf("scenarios:\n");
@@ -186,6 +195,8 @@ int main(int argc, char** argv) {
       scenarios.push_back(p);
     }
     for (const std::string& v : video_only) hqp::sim::presetScenario(v);
+    if (!recording.file.empty() && (scenarios.size() != 1 || scenarios[0].sweep))
+      throw std::runtime_error("--record needs exactly one scenario that is not a sweep");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "sim_demo: %s\n", e.what());
     return 2;
@@ -227,9 +238,16 @@ int main(int argc, char** argv) {
         hqp::sim::RunOptions o = hqp::sim::runOptions(p);
         o.out_dir = dir;
         o.progress = true;
+        if (!recording.file.empty() && !hqp::sim::startRecording(*driver, recording))
+          throw std::runtime_error("--record: this driver has no HQP to record (use the balance controller, hqp)");
         o.video = !no_video && (video_only.empty() || std::find(video_only.begin(), video_only.end(), p.name) !=
                                                           video_only.end());
         const hqp::sim::RunSummary r = hqp::sim::runScenario(sim, *driver, o);
+        if (!recording.file.empty()) {
+          const std::size_t n = hqp::sim::finishRecording(*driver);
+          std::printf("recorded %zu problem instances (%.3f s from %.3f s, every %d ticks) to %s\n", n,
+                      recording.duration, recording.start, recording.every, recording.file.c_str());
+        }
         record = hqp::sim::runRecord(p, r);
         if (!no_plots) record["files"]["plots"] = makePlots(paths, p, r.csv_path, dir);
       }

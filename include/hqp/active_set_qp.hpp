@@ -141,6 +141,22 @@ class ActiveSetQp {
     nw_ = 0;
     have_ws_ = false;
   }
+  // The warm start the next solve() sees (recording / replay of problem instances,
+  // docs/recording.md): the size n of the last resize(), and whether the working set above
+  // is kept for it (a solve ended on it and no resize or reset dropped it since).
+  int variables() const { return n_; }
+  bool hasWorkingSet() const { return have_ws_; }
+  // Sets the working set the next warm solve starts from, as if a solve at the current
+  // sizes had ended on it (rows: C rows, upper: side). The solve re-checks every row.
+  void setWorkingSet(int count, const int* rows, const bool* upper) {
+    nw_ = 0;
+    for (int k = 0; k < count && k < NV; ++k) {
+      ws_row_(k) = rows[k];
+      ws_upper_(k) = upper[k] ? 1 : 0;
+      ++nw_;
+    }
+    have_ws_ = true;
+  }
 
  private:
   static constexpr double kInf = std::numeric_limits<double>::infinity();

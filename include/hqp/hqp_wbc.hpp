@@ -207,6 +207,23 @@ class HqpWbc {
   const VectorX& x() const { return x_; }
   QpStatus status() const { return result_.status; }
 
+  // The stacked problem of the last solve() (rows of level p from task_offset[p] /
+  // constraint_offset[p]); for recording problem instances (hqp/problem_instance.hpp).
+  // The bounds are not offered: solve() drops or relaxes an infeasible level's bounds in place.
+  const Eigen::Matrix<double, capacity(total_task_rows), Nx>& stackedA() const { return A_; }
+  const Eigen::Matrix<double, capacity(total_task_rows), 1>& stackedB() const { return b_; }
+  const Eigen::Matrix<double, capacity(total_task_rows), 1>& stackedWeights() const { return w_; }
+  const Eigen::Matrix<double, capacity(total_constraint_rows), Nx>& stackedD() const { return D_; }
+
+  // Replay: level p's QP starts the next solve() from this working set (rows index the
+  // stacked constraint rows, as HqpLevelResult::active_row), which belongs to a QP of
+  // `variables` unknowns; if the level's QP then has another size, it starts cold, as in the
+  // run. False for a level without a QP (no constraint up to it).
+  bool setWorkingSet(int p, int variables, int count, const int* rows, const bool* upper) {
+    return setWorkingSetOf(p, variables, count, rows, upper,
+                           std::make_index_sequence<sizeof...(Levels)>{});
+  }
+
  private:
   using MatrixM = MaxMatrix<capacity(max_task_rows), Nx>;
   using VectorM = MaxVector<capacity(max_task_rows)>;
@@ -227,6 +244,25 @@ class HqpWbc {
   template <class Qp>
   static void resetQp(Qp& qp) {
     if constexpr (!std::is_same_v<Qp, detail::NoQp>) qp.resetWorkingSet();
+  }
+
+  template <std::size_t... I>
+  bool setWorkingSetOf(int p, int variables, int count, const int* rows, const bool* upper,
+                      std::index_sequence<I...>) {
+    bool ok = false;
+    const auto set = [&](auto& qp, int r, int c) {
+      if constexpr (!std::is_same_v<std::remove_reference_t<decltype(qp)>, detail::NoQp>) {
+        if (variables < 0 || variables > Nx) return;
+        qp.resize(variables, r, 0, c);  // the sizes solveLevel() will ask for if n matches
+        qp.setWorkingSet(count, rows, upper);
+        ok = true;
+      }
+    };
+    ((static_cast<int>(I) == p ? set(std::get<I>(qps_), LevelType<static_cast<int>(I)>::task_rows,
+                                     constraint_offset[I + 1])
+                               : void()),
+     ...);
+    return ok;
   }
 
   template <std::size_t... I>

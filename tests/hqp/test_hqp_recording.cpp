@@ -1,0 +1,326 @@
+// Recorded problem instances (hqp/problem_instance.hpp, hqp/problem_file.hpp, docs/recording.md):
+// the checked-in recording replays to the solutions the run computed, the file format round
+// trips, malformed files are refused with a message that names the problem, and capturing an
+// instance does not allocate. The expected solutions are the recorded ones: they came from the
+// controller's own HqpWbc during the MuJoCo run (sim_demo --record), not from this test's solver.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "hqp/problem_file.hpp"
+#include "hqp/problem_instance.hpp"
+#include "support/allocation_counter.hpp"
+
+#ifndef HQP_RECORDING_FILE
+#define HQP_RECORDING_FILE ""
+#endif
+
+namespace {
+
+using hqp::LevelRows;
+// Walker3's Table I (as recorded): 6 | 12, 12 | 18, 3, 15 rows over 30 variables.
+using Replay = hqp::StackedHqp<30, LevelRows<6, 12>, LevelRows<12, 18>, LevelRows<3, 0>, LevelRows<15, 0>>;
+using Instance = hqp::ProblemInstance<Replay>;
+// Another shape, for the dimension check (never solved: no HqpWbc code is generated for it).
+using Other = hqp::StackedHqp<30, LevelRows<6, 12>, LevelRows<12, 16>, LevelRows<3, 0>, LevelRows<15, 0>>;
+
+const std::vector<Instance>& recorded(hqp::ProblemFileInfo* info = nullptr) {
+  static hqp::ProblemFileInfo i;
+  static const std::vector<Instance> v = hqp::readProblemFile<Replay>(HQP_RECORDING_FILE, &i);
+  if (info) *info = i;
+  return v;
+}
+
+double scaledDiff(const Replay::VectorX& x, const Replay::VectorX& ref) {
+  return (x - ref).lpNorm<Eigen::Infinity>() / std::max(1.0, ref.lpNorm<Eigen::Infinity>());
+}
+
+std::vector<std::pair<int, bool>> activeSet(const hqp::HqpLevelResult<Replay::max_active>& l) {
+  std::vector<std::pair<int, bool>> s;
+  for (int k = 0; k < l.num_active; ++k) s.emplace_back(l.active_row[k], l.active_upper[k]);
+  std::sort(s.begin(), s.end());
+  return s;
+}
+
+TEST(Recording, CheckedInFileHasRealInstances) {
+  hqp::ProblemFileInfo info;
+  const auto& v = recorded(&info);
+  ASSERT_GE(v.size(), 50u) << info.source;
+  // Real, not trivial, instances: torque or contact rows active on some ticks, level 4 (the
+  // compromise) with a non-zero residual, and at least one tick on which a working set changed
+  // (a level's QP iterated from its warm start), so the warm replay below follows a path.
+  int with_active = 0, iterated = 0;
+  for (const auto& in : v) {
+    if (in.result.levels[0].num_active + in.result.levels[1].num_active > 0) ++with_active;
+    EXPECT_GT(in.result.levels[3].residual, 0.0);
+    int it = 0;
+    for (const auto& l : in.result.levels) it += l.iterations;
+    if (it > 0) ++iterated;
+  }
+  EXPECT_GT(with_active, 0);
+  EXPECT_GT(iterated, 0);
+  for (std::size_t k = 1; k < v.size(); ++k) EXPECT_GT(v[k].tick, v[k - 1].tick);
+}
+
+// Warm, from the recorded working sets, as in the run: the recorded x* to 1e-9 relative to its
+// largest entry, every level's status and active set as recorded.
+TEST(Recording, WarmReplayReproducesRecordedSolutions) {
+  hqp::ProblemFileInfo info;
+  const auto& v = recorded(&info);
+  auto wbc = std::make_unique<Replay>(info.settings);
+  double worst = 0.0;
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    hqp::loadInstance(v[k], *wbc, true);
+    wbc->solve();
+    const auto& r = wbc->result();
+    const double d = scaledDiff(r.x, v[k].result.x);
+    worst = std::max(worst, d);
+    EXPECT_LE(d, 1e-9) << "instance " << k;
+    EXPECT_EQ(r.status, v[k].result.status) << "instance " << k;
+    for (int p = 0; p < Replay::num_levels; ++p) {
+      EXPECT_EQ(r.levels[p].status, v[k].result.levels[p].status) << k << " level " << p;
+      EXPECT_EQ(activeSet(r.levels[p]), activeSet(v[k].result.levels[p])) << k << " level " << p;
+      // The same active-set path as in the run: the recorded working set was the start.
+      EXPECT_EQ(r.levels[p].iterations, v[k].result.levels[p].iterations) << k << " level " << p;
+      EXPECT_NEAR(r.levels[p].residual, v[k].result.levels[p].residual,
+                  1e-9 * std::max(1.0, v[k].result.levels[p].residual))
+          << k << " level " << p;
+    }
+  }
+  std::printf("warm replay of %zu instances: largest |dx|/max(1,|x|) = %.3g\n", v.size(), worst);
+}
+
+// Cold: the strict hierarchy's x* is unique here (no null space left after level 4), so the
+// cold solve must find the same point; the tolerance is looser (another active-set path).
+// The paths do differ (more iterations on some levels), which shows that the warm replay above
+// really started from the recorded working sets.
+TEST(Recording, ColdReplayFindsTheSameSolution) {
+  hqp::ProblemFileInfo info;
+  const auto& v = recorded(&info);
+  auto wbc = std::make_unique<Replay>(info.settings);
+  int other_path = 0;
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    hqp::loadInstance(v[k], *wbc, false);
+    wbc->solve();
+    ASSERT_EQ(wbc->result().levels[3].null_dim, 0);
+    EXPECT_LE(scaledDiff(wbc->result().x, v[k].result.x), 1e-7) << "instance " << k;
+    for (int p = 0; p < Replay::num_levels; ++p)
+      if (wbc->result().levels[p].iterations != v[k].result.levels[p].iterations) {
+        ++other_path;
+        break;
+      }
+  }
+  EXPECT_GT(other_path, 0);
+  std::printf("cold replay: %d of %zu instances took another active-set path than the run\n", other_path,
+              v.size());
+}
+
+// Bytes → instances → bytes is the identity on the checked-in file.
+TEST(Recording, FileRoundTripIsExact) {
+  const std::string bytes = hqp::problem_file::readWholeFile(HQP_RECORDING_FILE);
+  hqp::ProblemFileInfo info;
+  const auto v = hqp::decodeProblemFile<Replay>(bytes, "checked-in", &info);
+  const std::string again = hqp::encodeProblemFile<Replay>(v.data(), v.size(), info.settings, info.source);
+  EXPECT_TRUE(again == bytes);
+}
+
+// A synthetic instance with infinities, NaN-free odd values and full active sets survives a
+// write to disk and a read back field by field.
+TEST(Recording, WriteReadRoundTrip) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> nd;
+  std::vector<Instance> v(3);
+  for (std::size_t s = 0; s < v.size(); ++s) {
+    Instance& in = v[s];
+    in.tick = 1000 + static_cast<long>(s) * 7;
+    in.time = 1.0 + 0.007 * s;
+    for (int i = 0; i < in.A.rows(); ++i)
+      for (int j = 0; j < in.A.cols(); ++j) in.A(i, j) = nd(rng);
+    for (int i = 0; i < in.D.rows(); ++i)
+      for (int j = 0; j < in.D.cols(); ++j) in.D(i, j) = nd(rng) * 1e-300;
+    in.b.setRandom();
+    in.w.setConstant(0.25);
+    in.lower.setConstant(-hqp::kInf);
+    in.upper.setRandom();
+    in.upper(3) = hqp::kInf;
+    in.lower(4) = -0.0;
+    for (int p = 0; p < Replay::num_levels; ++p) {
+      in.warm[p].variables = 30 - 6 * p;
+      in.warm[p].num_active = p == 1 ? Instance::constraint_rows : p;
+      for (int k = 0; k < in.warm[p].num_active; ++k) {
+        in.warm[p].row[k] = (k * 7 + p) % Instance::constraint_rows;
+        in.warm[p].upper[k] = (k + p) % 2 == 0;
+      }
+      auto& l = in.result.levels[p];
+      l.status = static_cast<hqp::QpStatus>(p);
+      l.residual = nd(rng);
+      l.objective = std::ldexp(1.0, -1070);  // subnormal
+      l.rank = p;
+      l.null_dim = 2 * p;
+      l.variables = 3 * p;
+      l.iterations = 100 + p;
+      l.num_active = p + 1;
+      for (int k = 0; k < l.num_active; ++k) {
+        l.active_row[k] = Instance::constraint_rows - 1 - k;
+        l.active_upper[k] = k % 2 == 1;
+      }
+      l.constraints_dropped = p == 2;
+      l.slack_used = p == 3;
+      l.violation = 1e-17 * p;
+      l.time_us = 12.5 + p;
+    }
+    in.result.x.setRandom();
+    in.result.status = hqp::QpStatus::IterationLimit;
+    in.result.failed_level = 2;
+  }
+  hqp::HqpSettings settings;
+  settings.rank_tol = 3e-10;
+  settings.warm_start = false;
+  settings.qp.max_iterations = 77;
+  const std::string path = ::testing::TempDir() + "hqp_recording_roundtrip.hqprec";
+  hqp::writeProblemFile<Replay>(path, v.data(), v.size(), settings, "synthetic \xce\xbc test");
+  hqp::ProblemFileInfo info;
+  const auto back = hqp::readProblemFile<Replay>(path, &info);
+  std::remove(path.c_str());
+  EXPECT_EQ(info.version, 1u);
+  EXPECT_EQ(info.source, "synthetic \xce\xbc test");
+  EXPECT_EQ(info.settings.rank_tol, 3e-10);
+  EXPECT_FALSE(info.settings.warm_start);
+  EXPECT_EQ(info.settings.qp.max_iterations, 77);
+  EXPECT_EQ(info.task_rows, (std::vector<int>{6, 12, 3, 15}));
+  EXPECT_EQ(info.constraint_rows, (std::vector<int>{12, 18, 0, 0}));
+  ASSERT_EQ(back.size(), v.size());
+  for (std::size_t s = 0; s < v.size(); ++s) {
+    const Instance& a = v[s];
+    const Instance& b = back[s];
+    EXPECT_EQ(a.tick, b.tick);
+    EXPECT_EQ(a.time, b.time);
+    EXPECT_TRUE(a.A.topRows(36) == b.A.topRows(36));
+    EXPECT_TRUE(a.b.head(36) == b.b.head(36));
+    EXPECT_TRUE(a.w.head(36) == b.w.head(36));
+    EXPECT_TRUE(a.D.topRows(30) == b.D.topRows(30));
+    EXPECT_TRUE(a.lower.head(30) == b.lower.head(30));
+    EXPECT_TRUE(std::signbit(b.lower(4)));
+    EXPECT_TRUE(a.upper.head(30) == b.upper.head(30));
+    EXPECT_TRUE(a.result.x == b.result.x);
+    EXPECT_EQ(a.result.status, b.result.status);
+    EXPECT_EQ(a.result.failed_level, b.result.failed_level);
+    for (int p = 0; p < Replay::num_levels; ++p) {
+      EXPECT_EQ(a.warm[p].variables, b.warm[p].variables);
+      ASSERT_EQ(a.warm[p].num_active, b.warm[p].num_active);
+      for (int k = 0; k < a.warm[p].num_active; ++k) {
+        EXPECT_EQ(a.warm[p].row[k], b.warm[p].row[k]);
+        EXPECT_EQ(a.warm[p].upper[k], b.warm[p].upper[k]);
+      }
+      const auto& la = a.result.levels[p];
+      const auto& lb = b.result.levels[p];
+      EXPECT_EQ(la.status, lb.status);
+      EXPECT_EQ(la.residual, lb.residual);
+      EXPECT_EQ(la.objective, lb.objective);
+      EXPECT_EQ(la.rank, lb.rank);
+      EXPECT_EQ(la.null_dim, lb.null_dim);
+      EXPECT_EQ(la.variables, lb.variables);
+      EXPECT_EQ(la.iterations, lb.iterations);
+      EXPECT_EQ(la.constraints_dropped, lb.constraints_dropped);
+      EXPECT_EQ(la.slack_used, lb.slack_used);
+      EXPECT_EQ(la.violation, lb.violation);
+      EXPECT_EQ(la.time_us, lb.time_us);
+      ASSERT_EQ(la.num_active, lb.num_active);
+      for (int k = 0; k < la.num_active; ++k) {
+        EXPECT_EQ(la.active_row[k], lb.active_row[k]);
+        EXPECT_EQ(la.active_upper[k], lb.active_upper[k]);
+      }
+    }
+  }
+}
+
+// Decoding `bytes` throws ProblemFileError whose message contains `expect`.
+template <class Wbc = Replay>
+void expectRefused(const std::string& bytes, const std::string& expect) {
+  try {
+    hqp::decodeProblemFile<Wbc>(bytes, "bad.hqprec");
+    ADD_FAILURE() << "accepted, expected: " << expect;
+  } catch (const hqp::ProblemFileError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("bad.hqprec: "), std::string::npos) << what;
+    EXPECT_NE(what.find(expect), std::string::npos) << "message: " << what << "\nexpected: " << expect;
+  }
+}
+
+TEST(Recording, MalformedFilesAreRefusedWithTheReason) {
+  std::vector<Instance> v(2);
+  v[1].result.levels[1].num_active = 1;
+  const std::string good = hqp::encodeProblemFile<Replay>(v.data(), v.size(), {}, "two instances");
+  ASSERT_NO_THROW(hqp::decodeProblemFile<Replay>(good, "good"));
+  const std::size_t header = good.size() - 2 * hqp::problem_file::recordBytes(30, 4, 36, 30);
+
+  std::string bad = good;
+  bad[0] = 'X';
+  expectRefused(bad, "wrong magic number");
+  expectRefused("", "truncated file: 0 bytes, ended while reading the magic number");
+  expectRefused("HQPPROB\nxx", "truncated file: 10 bytes, ended while reading the version");
+  bad = good;
+  bad[8] = 2;  // version 2
+  expectRefused(bad, "unsupported version 2");
+  expectRefused(good.substr(0, 30), "truncated file: 30 bytes, ended while reading");
+  expectRefused(good.substr(0, good.size() - 1), "instance 1 is incomplete");
+  expectRefused(good.substr(0, header + 5), "instance 0 is incomplete");
+  expectRefused(good + "z", "unexpected trailing bytes");
+  expectRefused<Other>(good, "wrong dimensions: the file holds nx 30, 4 levels, task rows (6,12,3,15), "
+                             "constraint rows (12,18,0,0), this reader expects nx 30, 4 levels, task rows "
+                             "(6,12,3,15), constraint rows (12,16,0,0)");
+  // A corrupt count in a record: instance 1's level-2 active row count (its offset from the
+  // record layout in docs/recording.md).
+  const std::size_t level_results = header + hqp::problem_file::recordBytes(30, 4, 36, 30) +
+                                    16 + 8 * (36 * 30 + 2 * 36 + 30 * 30 + 2 * 30) + 4 * (8 + 8 * 30) + 8 * 30 + 8;
+  const std::size_t num_active_l2 = level_results + (32 + 32 + 8 * 30) + 5 * 4;
+  bad = good;
+  ASSERT_EQ(bad[num_active_l2], 1);
+  bad[num_active_l2] = 31;
+  expectRefused(bad, "instance 1: bad active row count 31");
+  bad = good;
+  bad[num_active_l2 - 20] = 9;  // level 2 status
+  expectRefused(bad, "instance 1: bad status 9");
+}
+
+// The capture in the control tick: fixed-size copies only.
+TEST(Recording, CaptureDoesNotAllocate) {
+  hqp::ProblemFileInfo info;
+  const auto& v = recorded(&info);
+  hqp::testing::g_counting = false;
+  auto wbc = std::make_unique<Replay>(info.settings);
+  auto out = std::make_unique<Instance>();
+  hqp::loadInstance(v[0], *wbc, true);
+  hqp::testing::g_news = 0;
+  hqp::testing::g_counting = true;
+  hqp::captureWarmStart(*wbc, *out);
+  wbc->solve();
+  hqp::captureProblem(*wbc, *out);
+  hqp::testing::g_counting = false;
+  EXPECT_EQ(hqp::testing::g_news.load(), 0);
+  // What was captured is the instance again: the same rows, incoming working sets and x*.
+  EXPECT_TRUE(out->A == v[0].A);
+  EXPECT_TRUE(out->D.topRows(30) == v[0].D.topRows(30));
+  EXPECT_TRUE(out->lower.head(30) == v[0].lower.head(30));
+  for (int p = 0; p < Replay::num_levels; ++p) {
+    EXPECT_EQ(out->warm[p].num_active, v[0].warm[p].num_active);
+    if (v[0].warm[p].num_active > 0) {
+      EXPECT_EQ(out->warm[p].variables, v[0].warm[p].variables);
+    }
+  }
+  EXPECT_LE(scaledDiff(out->result.x, v[0].result.x), 1e-9);
+  hqp::testing::g_counting = true;
+  auto* probe = new int(3);
+  hqp::testing::g_counting = false;
+  EXPECT_GE(hqp::testing::g_news.load(), 1);
+  delete probe;
+}
+
+}  // namespace
