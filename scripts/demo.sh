@@ -18,7 +18,7 @@ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release
 cmake --build "$build" -j"$(nproc)" --target sim_demo
 
 status=0
-# ~4 min wall on the 2-core machine (measured 4m09s without the build), ~2 min of it software-rendered video.
+# ~3 min wall on the 2-core machine (measured 176 s with the build up to date, 5 videos, at 171ef2d).
 "$build/sim_demo/sim_demo" --scenario stand --scenario push_x --scenario push_y --scenario push_sweep \
   --scenario seesaw_x --scenario seesaw_y --scenario skate_x --scenario skate_y --scenario skate_z \
   --scenario skate_roll --scenario skate_pitch --scenario skate_yaw --scenario skate_mixed --scenario skate_sweep \

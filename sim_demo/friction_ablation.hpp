@@ -1,6 +1,6 @@
 #pragma once
 // friction_ablation: the paper's Sec. V-A claim that joint friction compensation (eqs. 5, 7) is
-// essential, tested by running base scenarios (push_x, stand, ...) under friction-compensation
+// essential, tested by running base scenarios (push_x, stand, seesaw_y, ...) under friction-compensation
 // variants and comparing the joint torque tracking (τ_opt vs the torque the plant delivers after
 // its friction) and the ZMP tracking (measured vs optimized). docs/scenarios.md,
 // "Friction-compensation ablation". Not real-time code.

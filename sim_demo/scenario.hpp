@@ -28,7 +28,8 @@ struct SweepParams {
 // friction_ablation: every base scenario under every friction-compensation variant
 // (friction_ablation.hpp lists the variants).
 struct AblationParams {
-  std::vector<std::string> scenarios = {"push_x", "stand"};
+  // push_x: friction under pushes; stand: where compensation matters most; seesaw_y: a moving support (issue 6).
+  std::vector<std::string> scenarios = {"push_x", "stand", "seesaw_y"};
   std::vector<std::string> variants = {"on", "off", "low", "high", "config", "on_kdq0", "off_kdq0"};
 };
 
