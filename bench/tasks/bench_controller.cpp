@@ -64,12 +64,18 @@ void BM_Tick(benchmark::State& state) {
   for (auto& v : level_t) v.reserve(1 << 20);
   std::size_t k = 0;
   long safe = 0, non_optimal = 0;
+  // Per level: ticks whose QP changed its working set (iterations > 0), and active rows.
+  std::vector<long> iter_ticks(Controller::num_levels, 0), active(Controller::num_levels, 0);
   for (auto _ : state) {
     ctrl->tick(inputs[k], cmd);
     benchmark::DoNotOptimize(cmd.current.data());
     const auto& d = ctrl->diagnostics();
     for (int st = 0; st < kStages; ++st) t[st].push_back(d.time_us[st]);
-    for (int p = 0; p < Controller::num_levels; ++p) level_t[p].push_back(d.levels[p].time_us);
+    for (int p = 0; p < Controller::num_levels; ++p) {
+      level_t[p].push_back(d.levels[p].time_us);
+      if (d.levels[p].iterations > 0) ++iter_ticks[p];
+      active[p] += d.levels[p].num_active;
+    }
     if (d.mode != hqp::tasks::ControllerMode::Balance) {
       ++safe;
       ctrl->reset();
@@ -87,6 +93,14 @@ void BM_Tick(benchmark::State& state) {
   if (solver == Controller::Config::Solver::Hqp)
     for (int p = 0; p < Controller::num_levels; ++p)
       state.counters["level" + std::to_string(p + 1) + "_p50_us"] = percentile(level_t[p], 0.5);
+  const double ticks = static_cast<double>(state.iterations());
+  if (solver == Controller::Config::Solver::Hqp) {
+    for (int p = 0; p < Controller::num_levels; ++p) {
+      const std::string l = "level" + std::to_string(p + 1);
+      state.counters[l + "_iter_frac"] = static_cast<double>(iter_ticks[p]) / ticks;
+      state.counters[l + "_active"] = static_cast<double>(active[p]) / ticks;
+    }
+  }
   state.counters["safe_mode_ticks"] = static_cast<double>(safe);
   state.counters["non_optimal_ticks"] = static_cast<double>(non_optimal);
   state.SetLabel(solver == Controller::Config::Solver::Hqp ? "HqpWbc" : "WqpWbc");

@@ -232,6 +232,7 @@ class ActiveSetQp {
   Eigen::Matrix<int, NV, 1> cand_row_, cand_upper_;        // rows addWarmRows tries
   Eigen::Matrix<double, 8, NV> strip_;                     // 8 of their rows, reduced
   Eigen::Matrix<int, MI, 1> in_ws_;
+  Eigen::Matrix<int, MI, 1> skip_;  // iterate(): K version at which row j was found dependent
   Eigen::Matrix<double, NV, 1> rhs_;
   MatNN Q_, R_;
   bool qexplicit_ = false;  // Q_ is valid; otherwise Q is the product of Hv_, htau_
@@ -825,7 +826,12 @@ template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
 QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
   // Primal active-set loop; xc_ is feasible and satisfies K xc_ = rhs.
   int zero_steps = 0;  // consecutive degenerate steps → smallest-index rule
-  int skip_row = -1;   // a blocking row found dependent on K: ignored until K changes
+  // Blocking rows found dependent on K are ignored until K changes: row j is skipped while
+  // skip_(j) == kver. All of them, not only the last one: at a degenerate vertex two such
+  // rows otherwise take turns blocking a rounding-size step, forever (IterationLimit on
+  // ~1 in 1500 random degenerate hierarchies, tests/hqp/test_hqp_inequality.cpp).
+  int kver = 0;
+  if (mi_ > 0) skip_.head(mi_).setConstant(-1);
   // Ĉ x; skipped when the caller's feasibility check just computed it at this xc_.
   if (mi_ > 0 && !cx_at_xc_) cx_.head(mi_).noalias() = Cs_.topLeftCorner(mi_, n_) * xc_.head(n_);
   cx_at_xc_ = false;
@@ -838,8 +844,9 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
       dn = std::max(dn, std::abs(d_(i)));
       xn = std::max(xn, std::abs(xc_(i)));
     }
-    // A step at rounding level is no step: its direction is noise, not in null(K).
-    if (dn <= 1e-14 * (1.0 + xn)) dn = 0.0;
+    // A step at rounding level is no step: its direction is noise, not in null(K). With
+    // null(K) = {0} (a vertex: K has nv_ independent rows) every step is one.
+    if (dn <= 1e-14 * (1.0 + xn) || k_ == nv_) dn = 0.0;
     // Ratio test over the rows not in K (smallest index wins ties).
     double alpha = 1.0;
     int block = -1;
@@ -850,7 +857,7 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
       // Phase 1 rows: Ĉx − t ≤ û and Ĉx + t ≥ l̂.
       const double dt = nv_ > n_ ? d_(n_) : 0.0, xt = nv_ > n_ ? xc_(n_) : 0.0;
       for (int j = 0; j < mi_; ++j) {
-        if (in_ws_(j) || j == skip_row) continue;
+        if (in_ws_(j) || skip_(j) == kver) continue;
         // upper side: rises toward û
         const double adu = cd_(j) - dt;
         if (adu > dir_tol && us_(j) < kInf) {
@@ -887,7 +894,8 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
       ensureExplicit();
       // A row numerically dependent on K cannot be held; skip it until K changes.
       if (!trap_ && ++changes_ >= kEstablishAfter) establishStructure();
-      skip_row = addRow(block, block_upper) ? -1 : block;
+      if (addRow(block, block_upper)) ++kver;
+      else skip_(block) = kver;
       continue;
     }
     for (int i = 0; i < nv_; ++i) xc_(i) = xs_(i);  // exactly at the subproblem optimum
@@ -918,7 +926,7 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
     ensureExplicit();
     if (!trap_ && ++changes_ >= kEstablishAfter) establishStructure();
     removeRow(neq_ + drop);
-    skip_row = -1;
+    ++kver;
   }
 }
 

@@ -165,6 +165,7 @@ class HqpWbc {
   void resetWarmStart() {
     std::apply([](auto&... qp) { (resetQp(qp), ...); }, qps_);
     resetQp(slack_qp_);
+    try_free_ = makeTrue();
   }
 
   // Solves the hierarchy; no heap, no exceptions, bounded by the QPs' iteration caps.
@@ -240,6 +241,12 @@ class HqpWbc {
   template <std::size_t... I>
   static auto qpTupleType(std::index_sequence<I...>) -> std::tuple<LevelQp<static_cast<int>(I)>...>;
   using QpTuple = decltype(qpTupleType(std::make_index_sequence<sizeof...(Levels)>{}));
+
+  static constexpr std::array<bool, sizeof...(Levels)> makeTrue() {
+    std::array<bool, sizeof...(Levels)> a{};
+    for (auto& v : a) v = true;
+    return a;
+  }
 
   template <class Qp>
   static void resetQp(Qp& qp) {
@@ -366,10 +373,19 @@ class HqpWbc {
     const int k = ns.rank();
     // Every row below (lower tasks, all constraints) into the coordinates u = Q u':
     // u' = [row-space part (k); null part (n − k)], so Z_p is the last n − k columns.
-    if constexpr (below > 0) {
-      auto rows_below = W_.block(t0 + r, col0, below, n);
-      ns.applyQOnTheRight(rows_below);
-    }
+    // The last level's rows below are only its QP's constraint rows: rotated only if the
+    // QP runs (the free step below needs them only times a vector).
+    constexpr bool last = P + 1 == num_levels;
+    bool rotated = false;
+    auto rotateBelow = [&] {
+      if constexpr (below > 0) {
+        auto rows_below = W_.block(t0 + r, col0, below, n);
+        ns.applyQOnTheRight(rows_below);
+      }
+      rotated = true;
+    };
+    if (!last) rotateBelow();
+    bool direct = false;  // the QP below runs in u, not u' (last level only)
     ns.rotatedMatrix(Aq_);  // Â_p Q, truncated to rank k
     bq_ = bt_.template segment<r>(t0);
     bq_.array() *= sw.array();
@@ -383,10 +399,23 @@ class HqpWbc {
         u_.head(k) = ls_.solve(bq_);
       }
       lr.status = QpStatus::Optimal;
+    } else if (try_free_[P] && freeStep<P>(n, k, col0, rotated)) {
+      // The unconstrained minimum-norm step meets every row: it is the QP's optimum with
+      // an empty working set, so the QP (and the last level's rotation) is skipped. It is
+      // tried while the level's last solve was the free step or a QP that kept an empty
+      // working set (a failed try is wasted work: in the Walker3 controller level 4's
+      // working set changes on 61 % of ticks, and trying after every empty set made that
+      // level 5–10 % slower; docs/benchmarks.md).
+      lr.status = QpStatus::Optimal;
     } else {
+      // The last level with Â_p of full column rank (no null space left, nothing truncated)
+      // poses its QP in u itself: objective Â_p, constraint rows unrotated, u' = Qᵀ u after.
+      direct = last && k == n;
+      if (!rotated && !direct) rotateBelow();
       auto& qp = std::get<P>(qps_);
       qp.resize(n, r, 0, c);
-      qp.A() = Aq_;
+      if (direct) qp.A() = M_;
+      else qp.A() = Aq_;
       qp.b() = bq_;
       qp.C() = W_.block(total_task_rows, col0, c, n);
       qp.lower() = lower_.head(c) - dx_.head(c);
@@ -430,6 +459,7 @@ class HqpWbc {
       if (qp.x().size() == n && qp.x().allFinite()) u_ = qp.x();
       else if (lr.status == QpStatus::Optimal) lr.status = QpStatus::NumericalFailure;
       lr.num_active = std::min(qp.numActive(), max_active);
+      try_free_[P] = qp.numActive() == 0 && qp.iterations() == 0;
       for (int a = 0; a < lr.num_active; ++a) {
         lr.active_row[static_cast<std::size_t>(a)] = qp.activeRow(a);
         lr.active_upper[static_cast<std::size_t>(a)] = qp.activeAtUpper(a);
@@ -439,8 +469,15 @@ class HqpWbc {
     // x*_p = x*_{p−1} + Z_{p−1} Q u' (eq. 4): update the reduced right-hand sides of every
     // row below (in the new coordinates), and the level's own residual A_p x*_p − b_p =
     // (A_p Z_{p−1})(Q u') − (b_p − A_p x*_{p−1}) with its rows still in the old ones.
+    if (direct) {  // u_ holds u = Q u'
+      q_ = u_;
+      ns.applyQTransposeOnTheLeft(u_);
+    } else {
+      q_ = u_;
+      ns.applyQOnTheLeft(q_);
+    }
     up_[P] = u_;
-    if constexpr (below > 0) {
+    if constexpr (below > 0 && !last) {  // after the last level nobody reads bt_ or dx_
       tmp_.head(below).noalias() = W_.block(t0 + r, col0, below, n) * u_;
       if constexpr (below > total_constraint_rows)
         bt_.segment(t0 + r, below - total_constraint_rows) -=
@@ -449,8 +486,6 @@ class HqpWbc {
         dx_.head(total_constraint_rows) += tmp_.segment(below - total_constraint_rows,
                                                         total_constraint_rows);
     }
-    q_ = u_;
-    ns.applyQOnTheLeft(q_);
     const Eigen::Matrix<double, r, 1> e =
         W_.block(t0, col0, r, n) * q_ - bt_.template segment<r>(t0);
     n_ = n - k;
@@ -468,6 +503,51 @@ class HqpWbc {
     lr.residual = e.squaredNorm();
     lr.objective = (e.array().square() * w_.template segment<r>(t0).array()).sum();
     noteStatus(P, lr.status);
+  }
+
+  // The level's unconstrained minimum-norm step u' = [y; 0], y = argmin ‖L y − b'‖ with
+  // L = Â_p Q₁ (full column rank k), if it meets every constraint row up to k ≤ p as the QP
+  // would check it (rows scaled to unit norm, feasibility_tol; higher rows' bounds widened to
+  // contain 0 as in neutralizeLockedRows). A feasible unconstrained minimizer is the
+  // constrained one, and with an empty working set the QP returns exactly this point. Sets
+  // u_ and returns true, or returns false (u_ untouched) and the QP decides.
+  template <int P>
+  bool freeStep(int n, int k, int col0, bool rotated) {
+    constexpr int r = LevelType<P>::task_rows;
+    constexpr int c0 = constraint_offset[P];
+    constexpr int c = constraint_offset[P + 1];
+    constexpr int rows0 = total_task_rows;  // first constraint row in W_
+    if (k > 0) {
+      Ls_ = Aq_.leftCols(k);
+      bs_ = bq_;
+      if (detail::qpMinNormLeastSquares(Ls_, r, k, bs_, ys_, 0.0, ls_ws_) != k) return false;
+    }
+    // Constraint rows times u': rotated rows see [y; 0]; unrotated ones Q [y; 0].
+    auto Cw = W_.block(rows0, col0, c, n);
+    if (rotated) {
+      if (k > 0) tmp_.head(c).noalias() = Cw.leftCols(k) * ys_.head(k);
+      else tmp_.head(c).setZero();
+    } else {
+      q_.setZero(n);
+      q_.head(k) = ys_.head(k);
+      ns_[P].applyQOnTheLeft(q_);
+      tmp_.head(c).noalias() = Cw * q_;
+    }
+    cnorm_.head(c) = Cw.rowwise().squaredNorm();
+    const double tol2 = settings_.qp.feasibility_tol * settings_.qp.feasibility_tol;
+    for (int i = 0; i < c; ++i) {
+      double lo = lower_(i) - dx_(i), up = upper_(i) - dx_(i);
+      if (i < c0) {
+        lo = std::min(lo, 0.0);
+        up = std::max(up, 0.0);
+      }
+      const double v = tmp_(i);
+      const double viol = std::max(lo - v, v - up);
+      if (viol > 0.0 && viol * viol > tol2 * cnorm_(i)) return false;
+    }
+    u_.setZero(n);
+    u_.head(k) = ys_.head(k);
+    return true;
   }
 
   // Higher rows: their shifted bounds are widened to contain 0 (see below).
@@ -603,6 +683,7 @@ class HqpWbc {
   LeastSquares ls_;
   std::array<NullSpace<capacity(max_task_rows), Nx>, sizeof...(Levels)> ns_{};  // per level: Q_p
   std::array<bool, sizeof...(Levels)> slack_{};
+  std::array<bool, sizeof...(Levels)> try_free_ = makeTrue();  // try freeStep() at level p
   static constexpr std::array<bool, sizeof...(Levels)> slack_capable_{
       (Levels::slack && Levels::constraint_rows > 0)...};
 
@@ -633,6 +714,10 @@ class HqpWbc {
   MatrixM Aq_;                   // Â_p Q (truncated)
   VectorM bq_;                   // W^½ (b_p − A_p x*_{p−1})
   VectorU u_;                    // u' of the current level
+  MatrixM Ls_;                   // Â_p Q₁ for the free step (overwritten by its QR)
+  VectorM bs_;                   // its right-hand side (overwritten)
+  Eigen::Matrix<double, Nx, 1> ys_ = Eigen::Matrix<double, Nx, 1>::Zero();  // its solution
+  detail::QpMinNormWorkspace<capacity(max_task_rows), Nx> ls_ws_;
   Result result_{};
 };
 

@@ -7,9 +7,9 @@
 // null(M), orthonormally. In the rotated coordinates u = Q u', M Q = [Π R₁ᵀ  0]: the task
 // only sees the first k coordinates, the rest is the null space handed to lower levels.
 // The factorization is written here on max-size storage (Eigen's ColPivHouseholderQR was
-// a third of the hierarchy's linear algebra at these sizes, mostly its norm downdates):
-// the pivot is the largest remaining column norm, recomputed exactly at every step (no
-// downdating, so no cancellation), and it stops at the first pivot ≤ threshold, so Q is
+// a third of the hierarchy's linear algebra at these sizes): the pivot is the largest
+// remaining column norm (downdated, recomputed exactly where the downdate cancels and
+// before any rank decision), and it stops at the first pivot ≤ threshold, so Q is
 // the product of the k reflectors of the row space. Nothing allocates (no-malloc tests).
 
 #include <Eigen/Core>
@@ -46,21 +46,36 @@ class NullSpace {
     perm_.resize(rows_);
     for (int j = 0; j < rows_; ++j) perm_(j) = j;
     const int kmax = std::min(rows_, cols_);
+    // Squared column norms of the remaining rows, downdated by R(i, j)² after each step and
+    // recomputed exactly when the downdate has cancelled most of the last exact value (the
+    // LAPACK xGEQP3 safeguard). The pivot's own norm is always recomputed exactly, and when
+    // it is at or below the threshold all remaining norms are recomputed before the rank is
+    // decided: the stop rule stays exactly "largest remaining norm ≤ threshold".
+    for (int j = 0; j < rows_; ++j) {
+      cn_(j) = qr_.col(j).squaredNorm();
+      cref_(j) = cn_(j);
+    }
     for (int i = 0; i < kmax; ++i) {
       const int len = cols_ - i;
       int jmax = i;
-      double best = -1.0;
-      for (int j = i; j < rows_; ++j) {
-        const double nj = qr_.col(j).segment(i, len).squaredNorm();
-        if (nj > best) {
-          best = nj;
-          jmax = j;
+      for (int j = i + 1; j < rows_; ++j)
+        if (cn_(j) > cn_(jmax)) jmax = j;
+      double best = qr_.col(jmax).segment(i, len).squaredNorm();
+      if (!(std::sqrt(best) > threshold)) {
+        for (int j = i; j < rows_; ++j) {
+          const double nj = qr_.col(j).segment(i, len).squaredNorm();
+          if (nj > best) {
+            best = nj;
+            jmax = j;
+          }
         }
+        if (!(std::sqrt(best) > threshold)) break;  // |R_ii| would be ≤ threshold: rank = i
       }
-      if (!(std::sqrt(best) > threshold)) break;  // |R_ii| would be ≤ threshold: rank = i
       if (jmax != i) {
         qr_.col(i).swap(qr_.col(jmax));
         std::swap(perm_(i), perm_(jmax));
+        std::swap(cn_(i), cn_(jmax));
+        std::swap(cref_(i), cref_(jmax));
       }
       double tau = 0.0, beta = 0.0;
       qr_.col(i).segment(i, len).makeHouseholderInPlace(tau, beta);
@@ -75,6 +90,18 @@ class NullSpace {
           const double t = tau * (x(0) + v.dot(x.tail(len - 1)));
           x(0) -= t;
           x.tail(len - 1) -= t * v;
+          const double nj = cn_(j) - x(0) * x(0);
+          if (nj <= 1e-4 * cref_(j)) {
+            cn_(j) = x.tail(len - 1).squaredNorm();
+            cref_(j) = cn_(j);
+          } else {
+            cn_(j) = nj;
+          }
+        }
+      } else {
+        for (int j = i + 1; j < rows_; ++j) {
+          const double x0 = qr_(i, j);
+          cn_(j) = std::max(cn_(j) - x0 * x0, 0.0);
         }
       }
       rank_ = i + 1;
@@ -123,6 +150,20 @@ class NullSpace {
     }
   }
 
+  // y ← Qᵀ y (into the rotated coordinates u' = Qᵀ u).
+  template <class Vec>
+  void applyQTransposeOnTheLeft(Vec& y) const {
+    for (int i = 0; i < rank_; ++i) {
+      const double tau = tau_(i);
+      const int len = cols_ - i;
+      if (tau == 0.0 || len < 2) continue;
+      const auto v = qr_.col(i).segment(i + 1, len - 1);
+      const double t = tau * (y(i) + v.dot(y.segment(i + 1, len - 1)));
+      y(i) -= t;
+      y.segment(i + 1, len - 1) -= t * v;
+    }
+  }
+
   // Orthonormal basis Z of null(M) (cols x dim).
   template <class Dest>
   void basis(Dest& Z) const {
@@ -160,6 +201,7 @@ class NullSpace {
  private:
   Factor qr_;
   Coeffs tau_;
+  Eigen::Matrix<double, capacity(MaxRows), 1> cn_, cref_;  // column norms² (pivot search)
   Eigen::Matrix<int, Eigen::Dynamic, 1, 0, capacity(MaxRows), 1> perm_;
   int rows_ = 0;
   int cols_ = 0;
