@@ -165,7 +165,6 @@ class HqpWbc {
   void resetWarmStart() {
     std::apply([](auto&... qp) { (resetQp(qp), ...); }, qps_);
     resetQp(slack_qp_);
-    try_free_ = makeTrue();
   }
 
   // Solves the hierarchy; no heap, no exceptions, bounded by the QPs' iteration caps.
@@ -241,12 +240,6 @@ class HqpWbc {
   template <std::size_t... I>
   static auto qpTupleType(std::index_sequence<I...>) -> std::tuple<LevelQp<static_cast<int>(I)>...>;
   using QpTuple = decltype(qpTupleType(std::make_index_sequence<sizeof...(Levels)>{}));
-
-  static constexpr std::array<bool, sizeof...(Levels)> makeTrue() {
-    std::array<bool, sizeof...(Levels)> a{};
-    for (auto& v : a) v = true;
-    return a;
-  }
 
   template <class Qp>
   static void resetQp(Qp& qp) {
@@ -399,13 +392,13 @@ class HqpWbc {
         u_.head(k) = ls_.solve(bq_);
       }
       lr.status = QpStatus::Optimal;
-    } else if (try_free_[P] && freeStep<P>(n, k, col0, rotated)) {
+    } else if (std::get<P>(qps_).numActive() == 0 && freeStep<P>(n, k, col0, rotated)) {
       // The unconstrained minimum-norm step meets every row: it is the QP's optimum with
       // an empty working set, so the QP (and the last level's rotation) is skipped. It is
-      // tried while the level's last solve was the free step or a QP that kept an empty
-      // working set (a failed try is wasted work: in the Walker3 controller level 4's
-      // working set changes on 61 % of ticks, and trying after every empty set made that
-      // level 5–10 % slower; docs/benchmarks.md).
+      // tried when the level's incoming working set is empty (after a free step the working
+      // set is emptied), so the warm state is the working set alone and a recorded instance
+      // replays exactly (docs/recording.md).
+      std::get<P>(qps_).resetWorkingSet();
       lr.status = QpStatus::Optimal;
     } else {
       // The last level with Â_p of full column rank (no null space left, nothing truncated)
@@ -459,7 +452,6 @@ class HqpWbc {
       if (qp.x().size() == n && qp.x().allFinite()) u_ = qp.x();
       else if (lr.status == QpStatus::Optimal) lr.status = QpStatus::NumericalFailure;
       lr.num_active = std::min(qp.numActive(), max_active);
-      try_free_[P] = qp.numActive() == 0 && qp.iterations() == 0;
       for (int a = 0; a < lr.num_active; ++a) {
         lr.active_row[static_cast<std::size_t>(a)] = qp.activeRow(a);
         lr.active_upper[static_cast<std::size_t>(a)] = qp.activeAtUpper(a);
@@ -683,7 +675,6 @@ class HqpWbc {
   LeastSquares ls_;
   std::array<NullSpace<capacity(max_task_rows), Nx>, sizeof...(Levels)> ns_{};  // per level: Q_p
   std::array<bool, sizeof...(Levels)> slack_{};
-  std::array<bool, sizeof...(Levels)> try_free_ = makeTrue();  // try freeStep() at level p
   static constexpr std::array<bool, sizeof...(Levels)> slack_capable_{
       (Levels::slack && Levels::constraint_rows > 0)...};
 
