@@ -139,29 +139,13 @@ class NullSpace {
   // y ← Q y for a vector y of size cols() (e.g. u = Q u' back from the rotated coordinates).
   template <class Vec>
   void applyQOnTheLeft(Vec& y) const {
-    for (int i = rank_ - 1; i >= 0; --i) {
-      const double tau = tau_(i);
-      const int len = cols_ - i;
-      if (tau == 0.0 || len < 2) continue;
-      const auto v = qr_.col(i).segment(i + 1, len - 1);
-      const double t = tau * (y(i) + v.dot(y.segment(i + 1, len - 1)));
-      y(i) -= t;
-      y.segment(i + 1, len - 1) -= t * v;
-    }
+    for (int i = rank_ - 1; i >= 0; --i) reflect(i, y);
   }
 
   // y ← Qᵀ y (into the rotated coordinates u' = Qᵀ u).
   template <class Vec>
   void applyQTransposeOnTheLeft(Vec& y) const {
-    for (int i = 0; i < rank_; ++i) {
-      const double tau = tau_(i);
-      const int len = cols_ - i;
-      if (tau == 0.0 || len < 2) continue;
-      const auto v = qr_.col(i).segment(i + 1, len - 1);
-      const double t = tau * (y(i) + v.dot(y.segment(i + 1, len - 1)));
-      y(i) -= t;
-      y.segment(i + 1, len - 1) -= t * v;
-    }
+    for (int i = 0; i < rank_; ++i) reflect(i, y);
   }
 
   // Orthonormal basis Z of null(M) (cols x dim).
@@ -199,6 +183,18 @@ class NullSpace {
   int permutation(int l) const { return perm_(l); }  // column l of Mᵀ Π is row Π(l) of M
 
  private:
+  // y ← H_i y with the i-th stored reflector H_i = I − τ_i v_i v_iᵀ (v_i = [1; qr_ below i]).
+  template <class Vec>
+  void reflect(int i, Vec& y) const {
+    const double tau = tau_(i);
+    const int len = cols_ - i;
+    if (tau == 0.0 || len < 2) return;
+    const auto v = qr_.col(i).segment(i + 1, len - 1);
+    const double t = tau * (y(i) + v.dot(y.segment(i + 1, len - 1)));
+    y(i) -= t;
+    y.segment(i + 1, len - 1) -= t * v;
+  }
+
   Factor qr_;
   Coeffs tau_;
   Eigen::Matrix<double, capacity(MaxRows), 1> cn_, cref_;  // column norms² (pivot search)
