@@ -525,7 +525,6 @@ class HqpWbc {
       ns_[P].applyQOnTheLeft(q_);
       tmp_.head(c).noalias() = Cw * q_;
     }
-    cnorm_.head(c) = Cw.rowwise().squaredNorm();
     const double tol2 = settings_.qp.feasibility_tol * settings_.qp.feasibility_tol;
     for (int i = 0; i < c; ++i) {
       double lo = lower_(i) - dx_(i), up = upper_(i) - dx_(i);
@@ -535,7 +534,8 @@ class HqpWbc {
       }
       const double v = tmp_(i);
       const double viol = std::max(lo - v, v - up);
-      if (viol > 0.0 && viol * viol > tol2 * cnorm_(i)) return false;
+      // The row's norm only where a bound is crossed (most rows are strictly inside).
+      if (viol > 0.0 && viol * viol > tol2 * Cw.row(i).squaredNorm()) return false;
     }
     u_.setZero(n);
     u_.head(k) = ys_.head(k);
