@@ -1,0 +1,209 @@
+#pragma once
+// Dual active-set method (Goldfarb and Idnani, 1983) for a strictly convex least-squares QP:
+//   min_x ½‖A x − b‖²   s.t.   lower ≤ C x ≤ upper,   A (r × n, r ≥ n) of full column rank.
+// It starts at the unconstrained minimizer and adds the most violated row at a time, keeping
+// the multipliers dual feasible (≥ 0); the primal iterate is feasible only at the end. When
+// few rows end up active (the last level of the robot's hierarchy: 0–2 of 30) it costs one
+// QR of A plus O(n² + m n) per active row, against the primal method's per-level set-up.
+// It needs a Hessian AᵀA that is positive definite; HqpWbc uses it for a last level whose
+// Â_p has full column rank and falls back to ActiveSetQp otherwise (docs/hqp.md).
+// Factors (the paper's stable variant): A = Q_A [R; 0], Hessian AᵀA = RᵀR, J = R⁻¹ Q_J with
+// Q_J orthogonal, and Jᵀ N = [R_a; 0] for the active normals N (R_a upper triangular). Both
+// are updated with Givens rotations on adding and dropping a row.
+// Real-time: no heap (compile-time capacities), no exceptions, iterations capped.
+
+#include <Eigen/Core>
+
+#include <cmath>
+#include <limits>
+
+#include "hqp/detail/qp_min_norm_ls.hpp"
+#include "hqp/qp_settings.hpp"
+#include "hqp/qp_status.hpp"
+
+namespace hqp {
+
+template <int MaxN, int MaxRows, int MaxIneq>
+class DualActiveSetQp {
+  static_assert(MaxN > 0 && MaxRows >= MaxN && MaxIneq > 0, "sizes");
+
+ public:
+  using VectorX = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, MaxN, 1>;
+
+  // Factorizes A (rows r ≥ n, n columns) and forms the unconstrained minimizer R⁻¹ (Q_Aᵀ b).
+  // Returns false, and nothing is valid, unless 1/‖R⁻¹‖_F > min_sigma, a lower bound of
+  // σ_min(A): the objective is then strictly convex by at least that margin.
+  template <class MatA, class VecB>
+  bool factorize(const MatA& A, const VecB& b, int r, int n, double min_sigma) noexcept {
+    n_ = n;
+    if (n <= 0 || n > MaxN || r < n || r > MaxRows) return false;
+    F_.topLeftCorner(r, n) = A.topLeftCorner(r, n);
+    c_.head(r) = b.head(r);
+    if (!detail::qpHouseholderQr(F_, r, n, 0.0, tau_, work_)) return false;
+    for (int i = 0; i < n; ++i) detail::qpApplyReflector(F_, i, r, tau_(i), c_);
+    // J = R⁻¹ column by column (R upper triangular in F_).
+    J_.topLeftCorner(n, n).setZero();
+    for (int j = 0; j < n; ++j) {
+      J_(j, j) = 1.0 / F_(j, j);
+      for (int i = j - 1; i >= 0; --i)
+        J_(i, j) = -F_.row(i).segment(i + 1, j - i).dot(J_.col(j).segment(i + 1, j - i)) / F_(i, i);
+    }
+    const double jn2 = J_.topLeftCorner(n, n).squaredNorm();
+    if (!(jn2 < kInf) || !(jn2 * min_sigma * min_sigma < 1.0)) return false;
+    x0_.noalias() = J_.topLeftCorner(n, n) * c_.head(n);  // R⁻¹ (Q_Aᵀ b)(0:n)
+    return x0_.allFinite();
+  }
+
+  // Solves with the constraint rows C (m × n, n of factorize()) and their bounds (±inf for an
+  // absent side). Status: Optimal; Infeasible (a violated row is dependent on the active rows
+  // with no multiplier that can give way); IterationLimit; NumericalFailure. x() is only the
+  // solution when Optimal.
+  template <class MatC, class VecL, class VecU>
+  QpStatus solve(const MatC& C, const VecL& lower, const VecU& upper, int m,
+                 const QpSettings& settings) noexcept {
+    const int n = n_;
+    q_ = 0;
+    iterations_ = 0;
+    x_ = x0_;
+    if (m > MaxIneq) return QpStatus::NumericalFailure;
+    for (int j = 0; j < m; ++j) {
+      const double nrm = C.row(j).norm();
+      rinv_(j) = nrm > 0.0 ? 1.0 / nrm : 1.0;
+      active_(j) = 0;
+    }
+    cx_.head(m).noalias() = C.topLeftCorner(m, n) * x_;
+    for (;;) {
+      // Step 1: the most violated row side (violation scaled to a unit-norm row).
+      int p = -1;
+      bool up = false;
+      double worst = settings.feasibility_tol;
+      for (int j = 0; j < m; ++j) {
+        if (active_(j)) continue;
+        const double vl = (lower(j) - cx_(j)) * rinv_(j), vu = (cx_(j) - upper(j)) * rinv_(j);
+        if (vl > worst) worst = vl, p = j, up = false;
+        if (vu > worst) worst = vu, p = j, up = true;
+      }
+      if (p < 0) return x_.allFinite() ? QpStatus::Optimal : QpStatus::NumericalFailure;
+      const double sgn = up ? -1.0 : 1.0;  // normal n_p = sgn · C_p, n_pᵀ x ≥ sgn · bound
+      np_.head(n) = sgn * C.row(p).head(n).transpose();
+      double s = sgn * cx_(p) - (up ? -upper(p) : lower(p));  // < 0: violated
+      double uplus = 0.0;                                       // multiplier of n_p
+      // Step 2: move toward n_p until it holds, dropping rows whose multiplier reaches 0.
+      for (;;) {
+        if (iterations_ >= settings.max_iterations) return QpStatus::IterationLimit;
+        d_.head(n).noalias() = J_.topLeftCorner(n, n).transpose() * np_.head(n);
+        const double dz2 = d_.segment(q_, n - q_).squaredNorm();  // = n_pᵀ z
+        // Dual direction r = R_a⁻¹ d(0:q) (back substitution by columns).
+        r_.head(q_) = d_.head(q_);
+        for (int i = q_ - 1; i >= 0; --i) {
+          r_(i) /= Ra_(i, i);
+          r_.head(i) -= r_(i) * Ra_.col(i).head(i);
+        }
+        double t1 = kInf;
+        int drop = -1;
+        for (int i = 0; i < q_; ++i) {
+          if (r_(i) > 0.0 && u_(i) / r_(i) < t1) {
+            t1 = u_(i) / r_(i);
+            drop = i;
+          }
+        }
+        // n_p in the span of the active normals: no primal step (z = 0).
+        const bool primal = dz2 > 1e-24 * d_.head(n).squaredNorm() && dz2 > 0.0;
+        const double t2 = primal ? -s / dz2 : kInf;
+        if (drop < 0 && !primal) return QpStatus::Infeasible;
+        const double t = t2 <= t1 ? t2 : t1;
+        if (primal) {
+          z_.head(n).noalias() = J_.block(0, q_, n, n - q_) * d_.segment(q_, n - q_);
+          x_ += t * z_.head(n);
+          cx_.head(m).noalias() += t * (C.topLeftCorner(m, n) * z_.head(n));
+          s += t * dz2;
+        }
+        u_.head(q_) -= t * r_.head(q_);
+        uplus += t;
+        ++iterations_;
+        if (primal && t2 <= t1) {
+          addActive(p, up, uplus);
+          break;
+        }
+        dropActive(drop);
+      }
+    }
+  }
+
+  const VectorX& x() const { return x_; }
+  const VectorX& unconstrainedMinimizer() const { return x0_; }
+  int iterations() const { return iterations_; }
+  int numActive() const { return q_; }
+  int activeRow(int k) const { return row_(k); }
+  bool activeAtUpper(int k) const { return upper_(k) != 0; }
+  // μ_k ≥ 0 with Aᵀ(A x − b) + Σ_upper μ_k c_k − Σ_lower μ_k c_k = 0 (as ActiveSetQp).
+  double multiplier(int k) const { return u_(k); }
+
+ private:
+  static constexpr double kInf = std::numeric_limits<double>::infinity();
+  static double hyp(double a, double b) { return std::sqrt(a * a + b * b); }
+
+  // Rotation (a, b) → (ρ, 0) applied to columns i, i + 1 of J: J ← J Gᵀ.
+  void rotateJ(int i, double c, double s) {
+    for (int l = 0; l < n_; ++l) {
+      const double a = J_(l, i), b = J_(l, i + 1);
+      J_(l, i) = c * a + s * b;
+      J_(l, i + 1) = -s * a + c * b;
+    }
+  }
+
+  // d_ = Jᵀ n_p is set: rotations zero d(q + 1:) bottom-up; d(0:q) becomes R_a's new column.
+  void addActive(int p, bool up, double mult) {
+    for (int j = n_ - 1; j > q_; --j) {
+      const double a = d_(j - 1), b = d_(j);
+      if (b == 0.0) continue;
+      const double rho = hyp(a, b);
+      d_(j - 1) = rho;
+      d_(j) = 0.0;
+      rotateJ(j - 1, a / rho, b / rho);
+    }
+    Ra_.col(q_).head(q_ + 1) = d_.head(q_ + 1);
+    row_(q_) = p;
+    upper_(q_) = up ? 1 : 0;
+    u_(q_) = mult;
+    active_(p) = 1;
+    ++q_;
+  }
+
+  // Removes active row k: R_a loses column k, rotations restore the triangle (and turn J).
+  void dropActive(int k) {
+    active_(row_(k)) = 0;
+    for (int j = k; j < q_ - 1; ++j) {
+      Ra_.col(j).head(j + 2) = Ra_.col(j + 1).head(j + 2);
+      row_(j) = row_(j + 1);
+      upper_(j) = upper_(j + 1);
+      u_(j) = u_(j + 1);
+    }
+    --q_;
+    for (int j = k; j < q_; ++j) {
+      const double a = Ra_(j, j), b = Ra_(j + 1, j);
+      if (b == 0.0) continue;
+      const double rho = hyp(a, b);
+      const double c = a / rho, s = b / rho;
+      for (int l = j; l < q_; ++l) {
+        const double x = Ra_(j, l), y = Ra_(j + 1, l);
+        Ra_(j, l) = c * x + s * y;
+        Ra_(j + 1, l) = -s * x + c * y;
+      }
+      rotateJ(j, c, s);
+    }
+  }
+
+  int n_ = 0, q_ = 0, iterations_ = 0;
+  Eigen::Matrix<double, MaxRows, MaxN> F_;   // QR of A (R on and above the diagonal)
+  Eigen::Matrix<double, MaxN, 1> tau_;
+  Eigen::Matrix<double, MaxRows, 1> c_, work_;  // Q_Aᵀ b
+  Eigen::Matrix<double, MaxN, MaxN> J_, Ra_;
+  Eigen::Matrix<double, MaxN, 1> d_, z_, r_, np_, u_;
+  Eigen::Matrix<int, MaxN, 1> row_, upper_;
+  Eigen::Matrix<double, MaxIneq, 1> cx_, rinv_;
+  Eigen::Matrix<int, MaxIneq, 1> active_;
+  VectorX x0_, x_;
+};
+
+}  // namespace hqp

@@ -1,0 +1,168 @@
+// DualActiveSetQp (Goldfarb–Idnani) against an enumeration reference on small strictly
+// convex problems, the KKT conditions (computed here) on larger ones, infeasible and
+// rank-deficient cases, and the no-allocation guard.
+#define EIGEN_RUNTIME_NO_MALLOC
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "hqp/dual_active_set_qp.hpp"
+#include "support/allocation_counter.hpp"
+#include "support/brute_force_qp.hpp"
+
+namespace {
+
+using SmallQp = hqp::DualActiveSetQp<6, 10, 10>;
+using LargeQp = hqp::DualActiveSetQp<30, 40, 60>;
+
+template <class Qp>
+hqp::QpStatus solve(Qp& qp, const hqp::testing::RandomQp& p, bool* factorized = nullptr) {
+  const int n = static_cast<int>(p.A.cols()), r = static_cast<int>(p.A.rows());
+  const bool ok = qp.factorize(p.A, p.b, r, n, 1e-9);
+  if (factorized) *factorized = ok;
+  if (!ok) return hqp::QpStatus::NumericalFailure;
+  return qp.solve(p.C, p.lower, p.upper, static_cast<int>(p.C.rows()), hqp::QpSettings{});
+}
+
+// Largest scaled KKT residual: stationarity Aᵀ(Ax − b) + Σ ±μ c = 0, primal feasibility per
+// unit row, dual feasibility μ ≥ 0 and complementarity μ · slack = 0 on the reported rows.
+template <class Qp>
+double kktError(const Qp& qp, const hqp::testing::RandomQp& p) {
+  const Eigen::VectorXd x = qp.x();
+  const Eigen::VectorXd g = p.A.transpose() * (p.A * x - p.b);
+  Eigen::VectorXd s = g;
+  double scale = 1.0 + g.cwiseAbs().maxCoeff();
+  double err = 0.0;
+  for (int a = 0; a < qp.numActive(); ++a) {
+    const int j = qp.activeRow(a);
+    const double mu = qp.multiplier(a);
+    const Eigen::VectorXd t = (qp.activeAtUpper(a) ? mu : -mu) * p.C.row(j).transpose();
+    s += t;
+    scale = std::max(scale, t.cwiseAbs().maxCoeff());
+    err = std::max(err, -mu);
+    const double bound = qp.activeAtUpper(a) ? p.upper(j) : p.lower(j);
+    err = std::max(err, std::abs(mu) * std::abs(p.C.row(j).dot(x) - bound));
+  }
+  err /= scale;
+  err = std::max(err, s.cwiseAbs().maxCoeff() / scale);
+  const Eigen::VectorXd cx = p.C * x;
+  for (int j = 0; j < cx.size(); ++j) {
+    const double nrm = std::max(p.C.row(j).norm(), 1e-300);
+    if (std::isfinite(p.lower(j))) err = std::max(err, (p.lower(j) - cx(j)) / nrm);
+    if (std::isfinite(p.upper(j))) err = std::max(err, (cx(j) - p.upper(j)) / nrm);
+  }
+  return err;
+}
+
+TEST(QpDual, SmallStrictlyConvexProblemsMatchBruteForce) {
+  std::mt19937 rng(2026);
+  std::uniform_int_distribution<int> Un(1, 6), Uextra(0, 4), Umi(0, 10), U100(0, 99);
+  SmallQp qp;
+  int feasible = 0, infeasible = 0, active = 0;
+  for (int trial = 0; trial < 1500; ++trial) {
+    const int n = Un(rng);
+    const int m = n + Uextra(rng);
+    const int mi = Umi(rng);
+    const bool make_infeasible = U100(rng) < 10;
+    const auto p = hqp::testing::makeRandomQp(rng, n, m, 0, mi, -1, 0.35, false, make_infeasible);
+    const auto ref = hqp::testing::bruteForceQp(p.A, p.b, p.E, p.e, p.C, p.lower, p.upper);
+    bool factorized = false;
+    const hqp::QpStatus s = solve(qp, p, &factorized);
+    ASSERT_TRUE(factorized) << "trial " << trial;  // random full-rank A
+    if (!ref.feasible) {
+      EXPECT_EQ(s, hqp::QpStatus::Infeasible) << "trial " << trial;
+      ++infeasible;
+      continue;
+    }
+    ASSERT_EQ(s, hqp::QpStatus::Optimal) << "trial " << trial;
+    ++feasible;
+    active += qp.numActive() > 0;
+    const double xs = 1.0 + ref.x.cwiseAbs().maxCoeff();
+    EXPECT_LT((qp.x() - ref.x).cwiseAbs().maxCoeff() / xs, 1e-8) << "trial " << trial;
+    EXPECT_LT(kktError(qp, p), 1e-9) << "trial " << trial;
+  }
+  // The sample covers what it should.
+  EXPECT_GT(feasible, 1000);
+  EXPECT_GT(infeasible, 50);
+  EXPECT_GT(active, 500);
+}
+
+TEST(QpDual, LargerProblemsSatisfyKkt) {
+  std::mt19937 rng(77);
+  std::uniform_int_distribution<int> Un(9, 30), Umi(10, 60);
+  LargeQp qp;
+  int with_active = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const int n = Un(rng);
+    const int m = std::min(40, n + 5);
+    const int mi = Umi(rng);
+    auto p = hqp::testing::makeRandomQp(rng, n, m, 0, mi, -1, 0.5);
+    ASSERT_EQ(solve(qp, p), hqp::QpStatus::Optimal) << "trial " << trial;
+    with_active += qp.numActive() > 0;
+    EXPECT_LT(kktError(qp, p), 1e-9) << "trial " << trial;
+    EXPECT_LE(qp.iterations(), hqp::QpSettings{}.max_iterations);
+  }
+  EXPECT_GT(with_active, 250);
+}
+
+// Two rows that cannot hold together: x₀ ≤ 0 and x₀ ≥ 1 (and the same via a scaled copy).
+TEST(QpDual, DisjointRowsAreInfeasible) {
+  SmallQp qp;
+  hqp::testing::RandomQp p;
+  p.A = Eigen::MatrixXd::Identity(2, 2);
+  p.b = Eigen::Vector2d(0.5, 0.0);
+  p.C.resize(2, 2);
+  p.C << 1.0, 0.0, 3.0, 0.0;
+  const double inf = std::numeric_limits<double>::infinity();
+  p.lower = Eigen::Vector2d(-inf, 3.0);
+  p.upper = Eigen::Vector2d(0.0, inf);
+  EXPECT_EQ(solve(qp, p), hqp::QpStatus::Infeasible);
+  // An equality row (lower = upper) with a feasible partner: optimal, on the equality.
+  p.lower = Eigen::Vector2d(0.2, -inf);
+  p.upper = Eigen::Vector2d(0.2, 3.0);
+  ASSERT_EQ(solve(qp, p), hqp::QpStatus::Optimal);
+  EXPECT_NEAR(qp.x()(0), 0.2, 1e-12);
+  EXPECT_NEAR(qp.x()(1), 0.0, 1e-12);
+}
+
+// The method needs a positive definite Hessian: a rank-deficient A, or one whose smallest
+// singular value is below the requested margin, is refused.
+TEST(QpDual, RefusesObjectivesThatAreNotStrictlyConvex) {
+  SmallQp qp;
+  Eigen::MatrixXd A(4, 3);
+  A << 1, 2, 3, 4, 5, 6, 7, 8, 9, 1, 0, 1;
+  const Eigen::VectorXd b = Eigen::VectorXd::Ones(4);
+  EXPECT_TRUE(qp.factorize(A, b, 4, 3, 1e-9));
+  const double smin = Eigen::JacobiSVD<Eigen::MatrixXd>(A).singularValues().minCoeff();
+  // 1/‖R⁻¹‖_F ≤ σ_min: a margin above σ_min is always refused.
+  EXPECT_FALSE(qp.factorize(A, b, 4, 3, 1.01 * smin));
+  A.row(3) = A.row(0) + A.row(1);  // rank 2
+  A.col(2) = A.col(0) + A.col(1);
+  EXPECT_FALSE(qp.factorize(A, b, 4, 3, 1e-9));
+  EXPECT_FALSE(qp.factorize(A, b, 2, 3, 1e-9));  // fewer rows than columns
+}
+
+TEST(QpDual, SolveDoesNotAllocate) {
+  std::mt19937 rng(5);
+  LargeQp qp;
+  const auto p = hqp::testing::makeRandomQp(rng, 9, 15, 0, 30, -1, 0.5);
+  // Fixed-size copies, so that the calls below see no dynamic-size Eigen object.
+  Eigen::Matrix<double, 15, 9> A = p.A;
+  Eigen::Matrix<double, 15, 1> b = p.b;
+  Eigen::Matrix<double, 30, 9> C = p.C;
+  Eigen::Matrix<double, 30, 1> lo = p.lower, up = p.upper;
+  const long before = hqp::testing::g_news.load();
+  Eigen::internal::set_is_malloc_allowed(false);
+  const bool ok = qp.factorize(A, b, 15, 9, 1e-9);
+  const hqp::QpStatus s = qp.solve(C, lo, up, 30, hqp::QpSettings{});
+  Eigen::internal::set_is_malloc_allowed(true);
+  EXPECT_EQ(hqp::testing::g_news.load(), before);
+  EXPECT_TRUE(ok);
+  EXPECT_EQ(s, hqp::QpStatus::Optimal);
+  // The hook is live: an allocation made now is counted.
+  const long live = hqp::testing::g_news.load();
+  delete new int(1);
+  EXPECT_GT(hqp::testing::g_news.load(), live);
+}
+
+}  // namespace
