@@ -25,6 +25,7 @@
 
 #include "hqp/active_set_qp.hpp"
 #include "hqp/constraint.hpp"
+#include "hqp/dual_active_set_qp.hpp"
 #include "hqp/hqp_types.hpp"
 #include "hqp/level.hpp"
 #include "hqp/null_space.hpp"
@@ -36,6 +37,9 @@ struct HqpSettings {
   QpSettings qp{};          // settings of every level's QP (iteration cap, tolerances)
   double rank_tol = 1e-9;   // Â_p pivots ≤ rank_tol · (largest weighted row norm of A_p) count as 0
   bool warm_start = true;   // reuse each level's working set from the previous solve
+  // A last level whose Â_p has full column rank is a strictly convex QP: solve it with the
+  // dual method (DualActiveSetQp) from its unconstrained minimizer instead of ActiveSetQp.
+  bool dual_last_level = true;
 };
 
 // What happened at one level; MaxActive = capacity of the stacked constraint rows.
@@ -55,6 +59,7 @@ struct HqpLevelResult {
   bool slack_used = false;           // own constraints were relaxed minimally (slack option)
   double violation = 0.0;            // Σ over own rows of squared bound violation at x*
   double time_us = 0.0;              // wall time of this level's solve (steady_clock), µs
+  bool dual = false;                 // solved by DualActiveSetQp (HqpSettings::dual_last_level)
 };
 
 template <int Nx, int NumLevels, int MaxActive>
@@ -131,6 +136,13 @@ class HqpWbc {
   static constexpr bool has_slack_levels =
       ((Levels::slack && Levels::constraint_rows > 0) || ...);
   static constexpr int max_slack_rows = detail::maxSlackRows<Levels...>();
+  // The last level's dual solver (HqpSettings::dual_last_level): it sees at most as many
+  // variables as the level has task rows.
+  static constexpr int last_task_rows = LevelType<sizeof...(Levels) - 1>::task_rows;
+  using DualQp = std::conditional_t<
+      (total_constraint_rows > 0 && last_task_rows > 0),
+      DualActiveSetQp<std::min(Nx, last_task_rows), last_task_rows, capacity(total_constraint_rows)>,
+      detail::NoQp>;
   using SlackQp = std::conditional_t<
       has_slack_levels,
       ActiveSetQp<Nx + capacity(max_slack_rows), capacity(max_slack_rows), 0,
@@ -160,6 +172,7 @@ class HqpWbc {
   const HqpSettings& settings() const { return settings_; }
   void setRankTolerance(double tol) { settings_.rank_tol = tol; }
   void setWarmStart(bool on) { settings_.warm_start = on; }
+  void setDualLastLevel(bool on) { settings_.dual_last_level = on; }
 
   // Forget every level's working set (the next solve starts cold).
   void resetWarmStart() {
@@ -323,7 +336,7 @@ class HqpWbc {
       const int k = rank_[ps];
       q_ = up_[ps];
       if (n - k > 0 && v_.size() == n - k) q_.tail(n - k) += v_;
-      ns_[ps].applyQOnTheLeft(q_);
+      if (!unrotated_[ps]) ns_[ps].applyQOnTheLeft(q_);
       v_ = q_;
     }
     if (v_.size() == Nx) x_ = v_;
@@ -346,6 +359,7 @@ class HqpWbc {
     lr.variables = n;
     var_[P] = n;
     rank_[P] = 0;
+    unrotated_[P] = false;
 
     if (n == 0) {
       // Nothing left to move: only check the level's own constraints at x*.
@@ -361,6 +375,9 @@ class HqpWbc {
     const double scale = std::sqrt((A_.template middleRows<r>(t0).rowwise().squaredNorm().array() *
                                     w_.template segment<r>(t0).array())
                                        .maxCoeff());
+    if constexpr (P + 1 == num_levels && c > 0 && !std::is_same_v<DualQp, detail::NoQp>) {
+      if (settings_.dual_last_level && r >= n && dualLastLevel<P>(n, col0, scale, lr)) return;
+    }
     auto& ns = ns_[P];
     ns.compute(M_, settings_.rank_tol * scale);
     const int k = ns.rank();
@@ -486,6 +503,67 @@ class HqpWbc {
     finishLevel<P>(lr, e);
   }
 
+  // The last level when Â_p = M_ has full column rank: min ½‖Â_p u − b̂‖² over the rows of
+  // every level, a strictly convex QP in u itself (nothing is below, so no null space and no
+  // rotation), solved by the dual method from the unconstrained minimizer. The bounds are the
+  // ones ActiveSetQp would get (neutralizeLockedRows). Returns false, having changed nothing
+  // the general path reads, if 1/‖R⁻¹‖_F ≤ √r · rank_tol · scale (then NullSpace might find
+  // a rank below n; with σ_min above that bound its pivots all pass, docs/hqp.md) or if the
+  // dual method ends without an optimum (e.g. infeasible own rows: the general path handles
+  // them).
+  template <int P>
+  bool dualLastLevel(int n, int col0, double scale, HqpLevelResult<max_active>& lr) {
+    constexpr int r = LevelType<P>::task_rows;
+    constexpr int t0 = task_offset[P];
+    constexpr int c0 = constraint_offset[P];
+    constexpr int c = constraint_offset[P + 1];
+    bq_ = bt_.template segment<r>(t0);
+    bq_.array() *= w_.template segment<r>(t0).array().sqrt();
+    const double min_sigma = std::sqrt(static_cast<double>(r)) * settings_.rank_tol * scale;
+    if (!dual_.factorize(M_, bq_, r, n, min_sigma)) return false;
+    const auto Cw = W_.block(total_task_rows, col0, c, n);
+    cnorm_.head(c) = Cw.rowwise().squaredNorm();
+    const double tol = settings_.qp.feasibility_tol;
+    for (int i = 0; i < c; ++i) {
+      double lo = lower_(i) - dx_(i), up = upper_(i) - dx_(i);
+      if (i < c0) {  // as neutralizeLockedRows: u = 0 exactly feasible for higher rows
+        lo = std::min(lo, 0.0);
+        up = std::max(up, 0.0);
+      }
+      if (std::sqrt(cnorm_(i)) <= settings_.rank_tol * Dnorm_(i)) {  // locked by higher levels
+        const double sc = rowScale(Dnorm_(i));
+        if (i >= c0 && (lo / sc > tol || -up / sc > tol)) return false;
+        lo = -kInf;
+        up = kInf;
+      }
+      dlo_(i) = lo;
+      dup_(i) = up;
+    }
+    if (dual_.solve(Cw, dlo_, dup_, c, settings_.qp) != QpStatus::Optimal) return false;
+    u_ = dual_.x();
+    lr.status = QpStatus::Optimal;
+    lr.dual = true;
+    lr.iterations = dual_.iterations();
+    lr.num_active = std::min(dual_.numActive(), max_active);
+    for (int a = 0; a < lr.num_active; ++a) {
+      lr.active_row[static_cast<std::size_t>(a)] = dual_.activeRow(a);
+      lr.active_upper[static_cast<std::size_t>(a)] = dual_.activeAtUpper(a);
+    }
+    // The level's ActiveSetQp starts from this active set if a later tick needs it.
+    auto& qp = std::get<P>(qps_);
+    qp.resize(n, r, 0, c);
+    qp.setWorkingSet(lr.num_active, lr.active_row.data(), lr.active_upper.data());
+    up_[P] = u_;
+    unrotated_[P] = true;
+    const Eigen::Matrix<double, r, 1> e =
+        W_.block(t0, col0, r, n) * u_ - bt_.template segment<r>(t0);
+    n_ = 0;
+    lr.rank = n;
+    rank_[P] = n;
+    finishLevel<P>(lr, e);
+    return true;
+  }
+
   // e = A_p x*_p − b_p.
   template <int P, class Vec>
   void finishLevel(HqpLevelResult<max_active>& lr, const Vec& e) {
@@ -509,7 +587,12 @@ class HqpWbc {
     constexpr int c0 = constraint_offset[P];
     constexpr int c = constraint_offset[P + 1];
     constexpr int rows0 = total_task_rows;  // first constraint row in W_
-    if (k > 0) {
+    if (k == r) {
+      // Â_p Q₁ = Π R₁ᵀ is square: forward substitution, row Π(l) gives y_l (NullSpace).
+      const auto& R = ns_[P].matrixQR();
+      for (int l = 0; l < k; ++l)
+        ys_(l) = (bq_(ns_[P].permutation(l)) - R.col(l).head(l).dot(ys_.head(l))) / R(l, l);
+    } else if (k > 0) {
       Ls_ = Aq_.leftCols(k);
       bs_ = bq_;
       if (detail::qpMinNormLeastSquares(Ls_, r, k, bs_, ys_, 0.0, ls_ws_) != k) return false;
@@ -672,6 +755,8 @@ class HqpWbc {
   std::tuple<Levels...> levels_;
   QpTuple qps_;
   SlackQp slack_qp_;
+  DualQp dual_;
+  VectorC dlo_ = VectorC::Zero(), dup_ = VectorC::Zero();  // its bounds
   LeastSquares ls_;
   std::array<NullSpace<capacity(max_task_rows), Nx>, sizeof...(Levels)> ns_{};  // per level: Q_p
   std::array<bool, sizeof...(Levels)> slack_{};
@@ -700,6 +785,7 @@ class HqpWbc {
   int n_ = Nx;                   // columns of Z_p
   std::array<VectorU, sizeof...(Levels)> up_{};  // u'_p of every level
   std::array<int, sizeof...(Levels)> var_{}, rank_{};  // n and k of every level
+  std::array<bool, sizeof...(Levels)> unrotated_{};    // u'_p = u_p (dual path: no Q_p)
   VectorU q_, v_;                // Q u' / reconstruction scratch
   MatrixM M_;                    // Â_p
   MatrixM Aq_;                   // Â_p Q (truncated)

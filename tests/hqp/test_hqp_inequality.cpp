@@ -117,10 +117,15 @@ double maxViolation(const std::vector<hqp::testing::RefLevel>& L, const Eigen::V
 
 }  // namespace
 
-TEST(HqpInequality, PerLevelResidualsMatchBruteForceCascade) {
+// Both ways of solving the last level: the dual method (default; its Â_p has full column rank
+// in almost every trial) and ActiveSetQp.
+class HqpInequalityLastLevel : public ::testing::TestWithParam<bool> {};
+
+TEST_P(HqpInequalityLastLevel, PerLevelResidualsMatchBruteForceCascade) {
   std::mt19937 g(31);
   static Wbc wbc;
-  int trials = 0, with_active = 0, lower_active = 0, infeasible = 0;
+  wbc.setDualLastLevel(GetParam());
+  int trials = 0, with_active = 0, lower_active = 0, infeasible = 0, dual = 0, dual_active = 0;
   for (int trial = 0; trial < 240; ++trial) {
     const int kind = trial % 4;
     const auto L = makeLevels(kind, g);
@@ -139,6 +144,10 @@ TEST(HqpInequality, PerLevelResidualsMatchBruteForceCascade) {
       if (lr.num_active > 0) {
         ++with_active;
         lower_active += p >= 2;
+      }
+      if (lr.dual) {  // the last level by the dual method (HqpSettings::dual_last_level)
+        ++dual;
+        dual_active += lr.num_active > 0;
       }
     }
     if (any_dropped) {
@@ -162,7 +171,17 @@ TEST(HqpInequality, PerLevelResidualsMatchBruteForceCascade) {
   EXPECT_GT(with_active, 200);   // constraints were really active
   EXPECT_GT(lower_active, 50);   // also in the lower levels' QPs
   EXPECT_GE(infeasible, 60);     // kind 3 (and some random cases) really were infeasible
+  if (GetParam()) {
+    EXPECT_GT(dual, 200);
+    EXPECT_GT(dual_active, 150);
+  } else {
+    EXPECT_EQ(dual, 0);
+  }
 }
+INSTANTIATE_TEST_SUITE_P(HqpInequality, HqpInequalityLastLevel, ::testing::Values(true, false),
+                         [](const ::testing::TestParamInfo<bool>& i) {
+                           return i.param ? std::string("DualMethod") : std::string("ActiveSetQp");
+                         });
 
 // Degenerate vertices (the anti-cycling rule of ActiveSetQp, docs/active-set-qp.md "Iteration
 // bound"): random hierarchies, each from its own seed, with a duplicated level-2 row and a

@@ -184,12 +184,14 @@ TEST(Recording, WriteReadRoundTrip) {
   settings.rank_tol = 3e-10;
   settings.warm_start = false;
   settings.qp.max_iterations = 77;
+  settings.dual_last_level = false;
   const std::string path = ::testing::TempDir() + "hqp_recording_roundtrip.hqprec";
   hqp::writeProblemFile<Replay>(path, v.data(), v.size(), settings, "synthetic \xce\xbc test");
   hqp::ProblemFileInfo info;
   const auto back = hqp::readProblemFile<Replay>(path, &info);
   std::remove(path.c_str());
-  EXPECT_EQ(info.version, 1u);
+  EXPECT_EQ(info.version, 2u);
+  EXPECT_FALSE(info.settings.dual_last_level);
   EXPECT_EQ(info.source, "synthetic \xce\xbc test");
   EXPECT_EQ(info.settings.rank_tol, 3e-10);
   EXPECT_FALSE(info.settings.warm_start);
@@ -267,8 +269,8 @@ TEST(Recording, MalformedFilesAreRefusedWithTheReason) {
   expectRefused("", "truncated file: 0 bytes, ended while reading the magic number");
   expectRefused("HQPPROB\nxx", "truncated file: 10 bytes, ended while reading the version");
   bad = good;
-  bad[8] = 2;  // version 2
-  expectRefused(bad, "unsupported version 2");
+  bad[8] = 3;  // version 3
+  expectRefused(bad, "unsupported version 3");
   expectRefused(good.substr(0, 30), "truncated file: 30 bytes, ended while reading");
   expectRefused(good.substr(0, good.size() - 1), "instance 1 is incomplete");
   expectRefused(good.substr(0, header + 5), "instance 0 is incomplete");
