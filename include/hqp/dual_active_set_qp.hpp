@@ -57,10 +57,13 @@ class DualActiveSetQp {
   // Solves with the constraint rows C (m × n, n of factorize()) and their bounds (±inf for an
   // absent side). Status: Optimal; Infeasible (a violated row is dependent on the active rows
   // with no multiplier that can give way); IterationLimit; NumericalFailure. x() is only the
-  // solution when Optimal.
+  // solution when Optimal. Warm start: the rows prefer[0..count) (e.g. the previous active set)
+  // are added first while one of them is violated; any order of violated rows is valid for the
+  // method, this one avoids adding rows that are dropped again.
   template <class MatC, class VecL, class VecU>
   QpStatus solve(const MatC& C, const VecL& lower, const VecU& upper, int m,
-                 const QpSettings& settings) noexcept {
+                 const QpSettings& settings, const int* prefer = nullptr,
+                 int prefer_count = 0) noexcept {
     const int n = n_;
     q_ = 0;
     iterations_ = 0;
@@ -70,18 +73,23 @@ class DualActiveSetQp {
       const double nrm = C.row(j).norm();
       rinv_(j) = nrm > 0.0 ? 1.0 / nrm : 1.0;
       active_(j) = 0;
+      prefer_(j) = 0;
     }
+    for (int k = 0; k < prefer_count; ++k)
+      if (prefer[k] >= 0 && prefer[k] < m) prefer_(prefer[k]) = 1;
     cx_.head(m).noalias() = C.topLeftCorner(m, n) * x_;
     for (;;) {
       // Step 1: the most violated row side (violation scaled to a unit-norm row).
       int p = -1;
       bool up = false;
-      double worst = settings.feasibility_tol;
-      for (int j = 0; j < m; ++j) {
-        if (active_(j)) continue;
-        const double vl = (lower(j) - cx_(j)) * rinv_(j), vu = (cx_(j) - upper(j)) * rinv_(j);
-        if (vl > worst) worst = vl, p = j, up = false;
-        if (vu > worst) worst = vu, p = j, up = true;
+      for (int pass = prefer_count > 0 ? 0 : 1; pass < 2 && p < 0; ++pass) {
+        double worst = settings.feasibility_tol;
+        for (int j = 0; j < m; ++j) {
+          if (active_(j) || (pass == 0 && !prefer_(j))) continue;
+          const double vl = (lower(j) - cx_(j)) * rinv_(j), vu = (cx_(j) - upper(j)) * rinv_(j);
+          if (vl > worst) worst = vl, p = j, up = false;
+          if (vu > worst) worst = vu, p = j, up = true;
+        }
       }
       if (p < 0) return x_.allFinite() ? QpStatus::Optimal : QpStatus::NumericalFailure;
       const double sgn = up ? -1.0 : 1.0;  // normal n_p = sgn · C_p, n_pᵀ x ≥ sgn · bound
@@ -202,7 +210,7 @@ class DualActiveSetQp {
   Eigen::Matrix<double, MaxN, 1> d_, z_, r_, np_, u_;
   Eigen::Matrix<int, MaxN, 1> row_, upper_;
   Eigen::Matrix<double, MaxIneq, 1> cx_, rinv_;
-  Eigen::Matrix<int, MaxIneq, 1> active_;
+  Eigen::Matrix<int, MaxIneq, 1> active_, prefer_;
   VectorX x0_, x_;
 };
 

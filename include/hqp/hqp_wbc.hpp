@@ -539,7 +539,15 @@ class HqpWbc {
       dlo_(i) = lo;
       dup_(i) = up;
     }
-    if (dual_.solve(Cw, dlo_, dup_, c, settings_.qp) != QpStatus::Optimal) return false;
+    // The level's working set (the previous tick's active set, or a recorded one) goes first.
+    auto& qp = std::get<P>(qps_);
+    int prefer = 0;
+    if (settings_.warm_start && qp.hasWorkingSet() && qp.variables() == n) {
+      prefer = std::min(qp.numActive(), Nx);
+      for (int a = 0; a < prefer; ++a) prefer_[static_cast<std::size_t>(a)] = qp.activeRow(a);
+    }
+    if (dual_.solve(Cw, dlo_, dup_, c, settings_.qp, prefer_.data(), prefer) != QpStatus::Optimal)
+      return false;
     u_ = dual_.x();
     lr.status = QpStatus::Optimal;
     lr.dual = true;
@@ -550,7 +558,6 @@ class HqpWbc {
       lr.active_upper[static_cast<std::size_t>(a)] = dual_.activeAtUpper(a);
     }
     // The level's ActiveSetQp starts from this active set if a later tick needs it.
-    auto& qp = std::get<P>(qps_);
     qp.resize(n, r, 0, c);
     qp.setWorkingSet(lr.num_active, lr.active_row.data(), lr.active_upper.data());
     up_[P] = u_;
@@ -757,6 +764,7 @@ class HqpWbc {
   SlackQp slack_qp_;
   DualQp dual_;
   VectorC dlo_ = VectorC::Zero(), dup_ = VectorC::Zero();  // its bounds
+  std::array<int, Nx> prefer_{};                            // its warm start
   LeastSquares ls_;
   std::array<NullSpace<capacity(max_task_rows), Nx>, sizeof...(Levels)> ns_{};  // per level: Q_p
   std::array<bool, sizeof...(Levels)> slack_{};
