@@ -13,10 +13,12 @@
 #include <cmath>
 #include <cstddef>
 #include <tuple>
+#include <type_traits>
 #include <utility>
 
 #include "hqp/active_set_qp.hpp"
 #include "hqp/constraint.hpp"
+#include "hqp/dual_active_set_qp.hpp"
 #include "hqp/hqp_types.hpp"
 #include "hqp/level.hpp"
 #include "hqp/task.hpp"
@@ -28,6 +30,7 @@ struct WqpResult {
   Eigen::Matrix<double, Nx, 1> x = Eigen::Matrix<double, Nx, 1>::Zero();
   QpStatus status = QpStatus::Optimal;
   int iterations = 0;
+  bool dual = false;                            // solved by DualActiveSetQp (setDualMethod)
   double objective = 0.0;                       // Σ_p λ_p Σ w (a x − b)² at x
   std::array<double, NumLevels> residual{};     // ‖A_p x − b_p‖² per level (unweighted)
   int num_active = 0;
@@ -54,6 +57,10 @@ class WqpWbc {
   using VectorX = Eigen::Matrix<double, Nx, 1>;
   using Result = WqpResult<Nx, num_levels, max_active>;
   using Qp = ActiveSetQp<Nx, capacity(total_task_rows), 0, capacity(total_constraint_rows)>;
+  // Stacked weighted rows of full column rank make the QP strictly convex: the dual method.
+  using DualQp = std::conditional_t<(total_task_rows >= Nx && total_constraint_rows > 0),
+                                    DualActiveSetQp<Nx, total_task_rows, total_constraint_rows>,
+                                    detail::NoQp>;
   template <int P>
   using LevelType = std::tuple_element_t<P, std::tuple<Levels...>>;
 
@@ -79,6 +86,9 @@ class WqpWbc {
   }
   double levelWeight(int p) const { return level_weight_[static_cast<std::size_t>(p)]; }
   void setWarmStart(bool on) { warm_start_ = on; }
+  // Solve with DualActiveSetQp (on by default) when the weighted task rows have full column
+  // rank (1/‖R⁻¹‖_F > √T · rank_tol · ‖A‖_F with the QP's rank_tol), ActiveSetQp otherwise.
+  void setDualMethod(bool on) { dual_method_ = on; }
   void resetWarmStart() { qp_.resetWorkingSet(); }
 
   // One QP with all tasks (weighted) and all constraints; no heap, no exceptions.
@@ -103,9 +113,14 @@ class WqpWbc {
       qp_.lower() = lower_.head(total_constraint_rows);
       qp_.upper() = upper_.head(total_constraint_rows);
     }
-    result_.status = qp_.solve(warm_start_);
-    result_.iterations = qp_.iterations();
-    if (qp_.x().size() == Nx && qp_.x().allFinite()) {
+    result_.dual = dual_method_ && solveDual();
+    if (!result_.dual) {
+      result_.status = qp_.solve(warm_start_);
+      result_.iterations = qp_.iterations();
+    }
+    if (result_.dual) {
+      result_.x = dual_.x();
+    } else if (qp_.x().size() == Nx && qp_.x().allFinite()) {
       result_.x = qp_.x();
     } else {
       result_.x.setZero();
@@ -113,10 +128,12 @@ class WqpWbc {
     }
     result_.objective = (qp_.A() * result_.x - qp_.b()).squaredNorm();
     residuals(std::make_index_sequence<sizeof...(Levels)>{});
-    result_.num_active = std::min(qp_.numActive(), max_active);
-    for (int a = 0; a < result_.num_active; ++a) {
-      result_.active_row[static_cast<std::size_t>(a)] = qp_.activeRow(a);
-      result_.active_upper[static_cast<std::size_t>(a)] = qp_.activeAtUpper(a);
+    if (!result_.dual) {
+      result_.num_active = std::min(qp_.numActive(), max_active);
+      for (int a = 0; a < result_.num_active; ++a) {
+        result_.active_row[static_cast<std::size_t>(a)] = qp_.activeRow(a);
+        result_.active_upper[static_cast<std::size_t>(a)] = qp_.activeAtUpper(a);
+      }
     }
     return result_.status;
   }
@@ -126,6 +143,36 @@ class WqpWbc {
   const Qp& qp() const { return qp_; }
 
  private:
+  // The dual method on the QP's data, warm from the QP's working set (its active set is handed
+  // back as that working set). False: ActiveSetQp decides (rank-deficient rows, infeasible,
+  // iteration cap).
+  bool solveDual() {
+    if constexpr (std::is_same_v<DualQp, detail::NoQp>) {
+      return false;
+    } else {
+      const double min_sigma = std::sqrt(static_cast<double>(total_task_rows)) *
+                               qp_.settings().rank_tol * qp_.A().norm();
+      if (!dual_.factorize(qp_.A(), qp_.b(), total_task_rows, Nx, min_sigma)) return false;
+      int prefer = 0;
+      if (warm_start_ && qp_.hasWorkingSet() && qp_.variables() == Nx) {
+        prefer = std::min(qp_.numActive(), Nx);
+        for (int a = 0; a < prefer; ++a) prefer_[static_cast<std::size_t>(a)] = qp_.activeRow(a);
+      }
+      const QpStatus s = dual_.solve(qp_.C(), qp_.lower(), qp_.upper(), total_constraint_rows,
+                                     qp_.settings(), prefer_.data(), prefer);
+      if (s != QpStatus::Optimal) return false;
+      result_.status = s;
+      result_.iterations = dual_.iterations();
+      result_.num_active = std::min(dual_.numActive(), max_active);
+      for (int a = 0; a < result_.num_active; ++a) {
+        result_.active_row[static_cast<std::size_t>(a)] = dual_.activeRow(a);
+        result_.active_upper[static_cast<std::size_t>(a)] = dual_.activeAtUpper(a);
+      }
+      qp_.setWorkingSet(result_.num_active, result_.active_row.data(), result_.active_upper.data());
+      return true;
+    }
+  }
+
   template <std::size_t... I>
   void stackAll(std::index_sequence<I...>) {
     ((std::get<I>(levels_).stackTasks(A_, b_, w_, task_offset[I]),
@@ -158,8 +205,11 @@ class WqpWbc {
 
   std::tuple<Levels...> levels_;
   Qp qp_;
+  DualQp dual_;
+  std::array<int, Nx> prefer_{};
   std::array<double, sizeof...(Levels)> level_weight_{};
   bool warm_start_ = true;
+  bool dual_method_ = true;
   Eigen::Matrix<double, capacity(total_task_rows), Nx> A_ = decltype(A_)::Zero();
   Eigen::Matrix<double, capacity(total_task_rows), 1> b_ = decltype(b_)::Zero();
   Eigen::Matrix<double, capacity(total_task_rows), 1> w_ = decltype(w_)::Ones();

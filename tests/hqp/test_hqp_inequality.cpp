@@ -360,10 +360,15 @@ TEST(HqpInequality, SlackViolatesOwnConstraintsMinimally) {
   wbc.setSlack(1, false);
 }
 
+// Both solvers: the dual method (default, the weighted rows have full column rank in almost
+// every trial) and ActiveSetQp.
 TEST(WqpWbc, EqualsBruteForceWeightedQp) {
+ for (const bool dual_method : {true, false}) {
   std::mt19937 g(21);
   static Wqp wqp;
-  int with_active = 0;
+  wqp.setDualMethod(dual_method);
+  wqp.resetWarmStart();
+  int with_active = 0, dual = 0;
   for (int trial = 0; trial < 60; ++trial) {
     const auto L = makeLevels(trial % 3, g);
     const double ratio = trial % 2 == 0 ? 10.0 : 100.0;
@@ -394,8 +399,12 @@ TEST(WqpWbc, EqualsBruteForceWeightedQp) {
     EXPECT_NEAR(wqp.result().objective, 2.0 * bf.objective, 1e-9 * (1.0 + bf.objective));
     EXPECT_LT((wqp.x() - bf.x).norm(), 1e-7 * (1.0 + bf.x.norm())) << "trial " << trial;
     with_active += wqp.result().num_active > 0;
+    dual += wqp.result().dual;
   }
   EXPECT_GT(with_active, 30);
+  if (dual_method) EXPECT_GT(dual, 50);
+  else EXPECT_EQ(dual, 0);
+ }
 }
 
 TEST(WqpWbc, HugeRatioApproachesTheHierarchy) {
