@@ -17,7 +17,6 @@
 #include <cmath>
 #include <limits>
 
-#include "hqp/detail/qp_min_norm_ls.hpp"
 #include "hqp/qp_settings.hpp"
 #include "hqp/qp_status.hpp"
 
@@ -39,14 +38,43 @@ class DualActiveSetQp {
     if (n <= 0 || n > MaxN || r < n || r > MaxRows) return false;
     F_.topLeftCorner(r, n) = A.topLeftCorner(r, n);
     c_.head(r) = b.head(r);
-    if (!detail::qpHouseholderQr(F_, r, n, 0.0, tau_, work_)) return false;
-    for (int i = 0; i < n; ++i) detail::qpApplyReflector(F_, i, r, tau_(i), c_);
-    // J = R⁻¹ column by column (R upper triangular in F_).
+    // Householder QR, column by column on raw columns (at ≤ 15 x 9, Eigen's block
+    // expressions cost more than the flops): H_i = I − τ [1; v][1; v]ᵀ, v below the diagonal.
+    for (int i = 0; i < n; ++i) {
+      double* v = &F_(0, i);
+      double tail = 0.0;
+      for (int l = i + 1; l < r; ++l) tail += v[l] * v[l];
+      const double a = v[i];
+      double tau = 0.0, beta = a;
+      if (tail > 0.0) {
+        beta = -std::copysign(std::sqrt(a * a + tail), a);
+        tau = (beta - a) / beta;
+        const double inv = 1.0 / (a - beta);
+        for (int l = i + 1; l < r; ++l) v[l] *= inv;
+      }
+      if (!(beta != 0.0) || !std::isfinite(beta)) return false;
+      v[i] = beta;
+      if (tau == 0.0) continue;
+      for (int j = i + 1; j <= n; ++j) {  // columns i+1 .. n−1, then c (j = n)
+        double* x = j < n ? &F_(0, j) : c_.data();
+        double t = x[i];
+        for (int l = i + 1; l < r; ++l) t += v[l] * x[l];
+        t *= tau;
+        x[i] -= t;
+        for (int l = i + 1; l < r; ++l) x[l] -= t * v[l];
+      }
+    }
+    // J = R⁻¹, column j from R x = e_j by columns of R (contiguous).
     J_.topLeftCorner(n, n).setZero();
     for (int j = 0; j < n; ++j) {
-      J_(j, j) = 1.0 / F_(j, j);
-      for (int i = j - 1; i >= 0; --i)
-        J_(i, j) = -F_.row(i).segment(i + 1, j - i).dot(J_.col(j).segment(i + 1, j - i)) / F_(i, i);
+      double* x = &J_(0, j);
+      x[j] = 1.0;
+      for (int i = j; i >= 0; --i) {
+        x[i] /= F_(i, i);
+        const double xi = x[i];
+        const double* R = &F_(0, i);
+        for (int l = 0; l < i; ++l) x[l] -= xi * R[l];
+      }
     }
     const double jn2 = J_.topLeftCorner(n, n).squaredNorm();
     if (!(jn2 < kInf) || !(jn2 * min_sigma * min_sigma < 1.0)) return false;
@@ -204,8 +232,7 @@ class DualActiveSetQp {
 
   int n_ = 0, q_ = 0, iterations_ = 0;
   Eigen::Matrix<double, MaxRows, MaxN> F_;   // QR of A (R on and above the diagonal)
-  Eigen::Matrix<double, MaxN, 1> tau_;
-  Eigen::Matrix<double, MaxRows, 1> c_, work_;  // Q_Aᵀ b
+  Eigen::Matrix<double, MaxRows, 1> c_;  // Q_Aᵀ b
   Eigen::Matrix<double, MaxN, MaxN> J_, Ra_;
   Eigen::Matrix<double, MaxN, 1> d_, z_, r_, np_, u_;
   Eigen::Matrix<int, MaxN, 1> row_, upper_;
