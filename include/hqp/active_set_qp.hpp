@@ -10,10 +10,11 @@
 //    updated with the same rotations;
 //  - the subproblem optimum on the working set is x* = x_p + Z (A Z)⁺ (b − A x_p)
 //    with x_p the minimum-norm point of K x = rhs, so the step is defined for any
-//    rank and x* is the minimum-norm minimizer on the working set. After two
-//    working-set changes G_Z = Uᵀ A Z is kept in the form [T 0; 0 0] (T upper
-//    triangular) and (A Z)⁺ is a triangular solve; before that, or if T is
-//    numerically singular, a complete orthogonal decomposition is used;
+//    rank and x* is the minimum-norm minimizer on the working set. G_Z = Uᵀ A Z is
+//    kept in the form [T 0; 0 0] (T upper triangular) from the start of a cold solve,
+//    or after two working-set changes of a warm one, and (A Z)⁺ is a triangular solve;
+//    before that, or if T is numerically singular, a complete orthogonal
+//    decomposition is used;
 //  - multipliers by Kᵀ λ = −Aᵀ(A x − b) through the same QR;
 //  - phase 1 is the same method on min ½t² s.t. lower − t ≤ Ĉ x ≤ upper + t, E x = e
 //    (Ĉ: rows scaled to unit norm).
@@ -160,7 +161,8 @@ class ActiveSetQp {
 
  private:
   static constexpr double kInf = std::numeric_limits<double>::infinity();
-  // Working-set changes after which the two-sided structure pays for itself.
+  // Working-set changes after which the two-sided structure pays for itself (warm
+  // starts and phase 1; a cold phase 2 sets it up before its first subproblem).
   static constexpr int kEstablishAfter = 2;
   using MatNN = Eigen::Matrix<double, NV, NV>;
   using VecN = Eigen::Matrix<double, NV, 1>;
@@ -549,7 +551,7 @@ void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addRowStructured(double rhs) {
   }
   // Q: the chain, storing each column one to the right and the target at k; G likewise.
   if (last > 0) {
-    detail::rotationChain<detail::RotationChain::UpShift>(Q_, nv_, k_, k_ + last, 0, rc_, rs_);
+    detail::rotationChain<detail::RotationChain::UpShift>(Q_, nv_, k_, k_ + last, rc_, rs_);
     for (int l = 0; l < mc_; ++l) {
       double* g = &AQ_(l, k_);
       const double t = g[last];

@@ -77,55 +77,35 @@ inline void reflectRowStrips(MatY&& Y, int rows, int cols, const MatV& V, const 
 // pair (x, y)). The shared column stays in registers, 8 rows at a time, so each rotation
 // costs one load and one store per 8 rows instead of two of each (and no call per
 // rotation):
-//   Down:  pairs (i − 1, i) for i = last, last − 1, …, first + 1   (c(i), s(i))
-//   Up:    pairs (j, j + 1) for j = first, …, last − 1              (c(j), s(j))
-//   Pivot: pairs (i, pivot) for i = last, last − 1, …, first        (c(i), s(i))
+//   Up:      pairs (j, j + 1) for j = first, …, last − 1   (c(j), s(j))
 //   UpShift: as Up, but column j is stored at j + 1 and the final column last at first
-//   (the rotated columns shifted right by one, the last one moved to the front).
-enum class RotationChain { Down, Up, UpShift, Pivot };
+//            (the rotated columns shifted right by one, the last one moved to the front).
+enum class RotationChain { Up, UpShift };
 
 template <RotationChain K, int L, class MatY, class VecCs>
-inline void rotationChainBlock(MatY& Y, int r0, int first, int last, int pivot, const VecCs& c,
+inline void rotationChainBlock(MatY& Y, int r0, int first, int last, const VecCs& c,
                                const VecCs& s) {
   using Vec = Eigen::Matrix<double, L, 1>;
-  if constexpr (K == RotationChain::Down) {
-    Vec y = Y.col(last).template segment<L>(r0);  // carried: column i
-    for (int i = last; i > first; --i) {
-      const Vec x = Y.col(i - 1).template segment<L>(r0);
-      Y.col(i).template segment<L>(r0) = c(i) * y - s(i) * x;
-      y = c(i) * x + s(i) * y;
-    }
-    Y.col(first).template segment<L>(r0) = y;
-  } else if constexpr (K == RotationChain::Up || K == RotationChain::UpShift) {
-    constexpr int shift = K == RotationChain::UpShift ? 1 : 0;
-    Vec x = Y.col(first).template segment<L>(r0);  // carried: column j
-    for (int j = first; j < last; ++j) {
-      const Vec y = Y.col(j + 1).template segment<L>(r0);
-      Y.col(j + shift).template segment<L>(r0) = c(j) * x + s(j) * y;
-      x = c(j) * y - s(j) * x;
-    }
-    Y.col(shift ? first : last).template segment<L>(r0) = x;
-  } else {
-    Vec y = Y.col(pivot).template segment<L>(r0);  // carried: the pivot column
-    for (int i = last; i >= first; --i) {
-      const Vec x = Y.col(i).template segment<L>(r0);
-      Y.col(i).template segment<L>(r0) = c(i) * x + s(i) * y;
-      y = c(i) * y - s(i) * x;
-    }
-    Y.col(pivot).template segment<L>(r0) = y;
+  constexpr int shift = K == RotationChain::UpShift ? 1 : 0;
+  Vec x = Y.col(first).template segment<L>(r0);  // carried: column j
+  for (int j = first; j < last; ++j) {
+    const Vec y = Y.col(j + 1).template segment<L>(r0);
+    Y.col(j + shift).template segment<L>(r0) = c(j) * x + s(j) * y;
+    x = c(j) * y - s(j) * x;
   }
+  Y.col(shift ? first : last).template segment<L>(r0) = x;
 }
 
 template <RotationChain K, class MatY, class VecCs>
-inline void rotationChain(MatY& Y, int rows, int first, int last, int pivot, const VecCs& c,
+inline void rotationChain(MatY& Y, int rows, int first, int last, const VecCs& c,
                           const VecCs& s) {
   constexpr int MaxRowsY = MatY::MaxRowsAtCompileTime;
   int r0 = 0;
   if constexpr (MaxRowsY == Eigen::Dynamic || MaxRowsY >= 8)
-    for (; r0 + 8 <= rows; r0 += 8) rotationChainBlock<K, 8>(Y, r0, first, last, pivot, c, s);
+    for (; r0 + 8 <= rows; r0 += 8) rotationChainBlock<K, 8>(Y, r0, first, last, c, s);
   if constexpr (MaxRowsY == Eigen::Dynamic || MaxRowsY >= 4)
-    for (; r0 + 4 <= rows; r0 += 4) rotationChainBlock<K, 4>(Y, r0, first, last, pivot, c, s);
-  for (; r0 < rows; ++r0) rotationChainBlock<K, 1>(Y, r0, first, last, pivot, c, s);
+    for (; r0 + 4 <= rows; r0 += 4) rotationChainBlock<K, 4>(Y, r0, first, last, c, s);
+  for (; r0 < rows; ++r0) rotationChainBlock<K, 1>(Y, r0, first, last, c, s);
 }
 
 }  // namespace hqp::detail
