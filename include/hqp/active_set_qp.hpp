@@ -10,10 +10,11 @@
 //    updated with the same rotations;
 //  - the subproblem optimum on the working set is x* = x_p + Z (A Z)⁺ (b − A x_p)
 //    with x_p the minimum-norm point of K x = rhs, so the step is defined for any
-//    rank and x* is the minimum-norm minimizer on the working set. After two
-//    working-set changes G_Z = Uᵀ A Z is kept in the form [T 0; 0 0] (T upper
-//    triangular) and (A Z)⁺ is a triangular solve; before that, or if T is
-//    numerically singular, a complete orthogonal decomposition is used;
+//    rank and x* is the minimum-norm minimizer on the working set. G_Z = Uᵀ A Z is
+//    kept in the form [T 0; 0 0] (T upper triangular) from the start of a cold solve,
+//    or after two working-set changes of a warm one, and (A Z)⁺ is a triangular solve;
+//    before that, or if T is numerically singular, a complete orthogonal
+//    decomposition is used;
 //  - multipliers by Kᵀ λ = −Aᵀ(A x − b) through the same QR;
 //  - phase 1 is the same method on min ½t² s.t. lower − t ≤ Ĉ x ≤ upper + t, E x = e
 //    (Ĉ: rows scaled to unit norm).
@@ -160,7 +161,8 @@ class ActiveSetQp {
 
  private:
   static constexpr double kInf = std::numeric_limits<double>::infinity();
-  // Working-set changes after which the two-sided structure pays for itself.
+  // Working-set changes after which the two-sided structure pays for itself (warm
+  // starts and phase 1; a cold phase 2 sets it up before its first subproblem).
   static constexpr int kEstablishAfter = 2;
   using MatNN = Eigen::Matrix<double, NV, NV>;
   using VecN = Eigen::Matrix<double, NV, 1>;
@@ -174,6 +176,10 @@ class ActiveSetQp {
   bool addRowVector(double rhs);       // adds a_ (length nv_) to K
   void removeRow(int pos);             // removes K row pos (pos ≥ neq_)
   void addWarmRows(int nw_prev);       // re-adds ws_prev_* (all at once while Q is implicit)
+  // Adds cnt rows (entry c of row l: row(l, c); the phase-1 t entry is 0) to K while Q is
+  // implicit, as one right-looking QR in 8-row strips; held(l, independent) after each.
+  template <class Row, class Rhs, class Held>
+  void addRowsImplicit(int cnt, Row row, Rhs rhs, Held held);
   // A previous working-set row that can be re-added: in range, not held yet, finite bound.
   bool warmUsable(int j, bool up) const {
     return j >= 0 && j < mi_ && !in_ws_(j) && std::abs(up ? us_(j) : ls_(j)) < kInf;
@@ -189,10 +195,25 @@ class ActiveSetQp {
   void applyReflector(int j, VecN& v) const;  // v ← H_j v
   void applyQ(VecN& v) const;                 // v ← Q v (v holds nv_ entries)
   void ensureExplicit();                      // Q_ ← H_0 ⋯ H_{k−1}
-  void minNormPoint(VecN& out);               // Q₁ R⁻ᵀ rhs (uses y_)
+  // Q_ ← H_0 ⋯ H_{last−1}: the identity's rows through the 8-row strip kernel.
+  void formQ(int last) {
+    Q_.topLeftCorner(nv_, nv_).setIdentity();
+    detail::reflectRowStrips<NV>(Q_, nv_, nv_, Hv_, htau_, 0, last);
+  }
+  void minNormPoint(VecN& out);               // Q₁ R⁻ᵀ rhs
+  // yr_ = R⁻ᵀ rhs. Adding a row appends to R and rhs, removing row pos changes them from
+  // pos on: entries below ny_ stay valid, so only the new ones are computed.
+  void solveRt() {
+    for (int i = ny_; i < k_; ++i) {
+      // dot products (vectorized), not a serial chain of scalar updates
+      yr_(i) = (rhs_(i) - R_.col(i).head(i).dot(yr_.head(i))) / R_(i, i);
+    }
+    ny_ = k_;
+  }
   // Two-sided structure of G_Z = Uᵀ A Z = [T 0; 0 0], T upper triangular
   // (r = min(m, nz)): see docs/active-set-qp.md, "Incremental factorizations".
   void colRot(int i, int j, double c, double s);  // Q, G columns i, j
+  void gColRot(int i, int j, double c, double s, int rows);  // G columns i, j, rows [0, rows)
   // G rows i, j and c̃; Z columns before local index zfrom are zero in both rows.
   void rowRot(int i, int j, double c, double s, int zfrom = 0);
   void establishStructure();                      // G_Z → [T 0; 0 0]
@@ -224,6 +245,7 @@ class ActiveSetQp {
   int k_ = 0, neq_ = 0, nw_ = 0;
   bool have_ws_ = false;
   bool xs_fresh_ = false;  // xs_ is the subproblem optimum of the current K
+  bool cold_ = false;      // this solve has no previous working set to start from
   Eigen::Matrix<int, NV, 1> eq_pos_;     // E row of K row i < neq_
   Eigen::Matrix<int, NV, 1> ws_row_;     // C row of K row neq_ + i
   Eigen::Matrix<int, NV, 1> ws_upper_;   // side
@@ -245,6 +267,10 @@ class ActiveSetQp {
   Eigen::Matrix<double, (MR > NV ? MR : NV), 1> hv_;  // reflector scratch
   Eigen::Matrix<double, MR, NV> M_;       // A Z scratch
   Eigen::Matrix<double, MR, 1> r_;        // residual scratch
+  Eigen::Matrix<double, MR, 1> dinv_;     // 1 / T(i, i)
+  VecN rc_, rs_;                          // recorded rotations (detail::rotationChain)
+  VecN yr_;                               // R⁻ᵀ rhs, valid below ny_
+  int ny_ = 0;
   VecN a_, w_, xs_, xc_, d_, y_, p_, lam_;
   Eigen::Matrix<double, (MR > NV ? MR : NV), 1> work_;  // Householder workspace
   Eigen::Matrix<double, MI, 1> cd_, cx_;  // Ĉ d, Ĉ x (ratio test)
@@ -325,24 +351,14 @@ void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::applyQ(VecN& v) const {
 template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
 void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::ensureExplicit() {
   if (qexplicit_) return;
-  // Backward accumulation: H_j only touches rows/columns ≥ j of H_{j+1} ⋯ H_{k−1}.
-  Q_.topLeftCorner(nv_, nv_).setIdentity();
-  for (int j = k_ - 1; j >= 0; --j) {
-    const int len = nv_ - j;
-    if (len > 1 && htau_(j) != 0.0)
-      Q_.block(j, j, len, len)
-          .applyHouseholderOnTheLeft(Hv_.col(j).segment(j + 1, len - 1), htau_(j), work_.data());
-  }
+  formQ(k_);
   qexplicit_ = true;
 }
 
 template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
 void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::minNormPoint(VecN& out) {
-  for (int i = 0; i < k_; ++i) {  // Rᵀ y = rhs
-    // dot products (vectorized), not a serial chain of scalar updates
-    y_(i) = (rhs_(i) - R_.col(i).head(i).dot(y_.head(i))) / R_(i, i);
-  }
-  out.head(k_) = y_.head(k_);
+  solveRt();
+  out.head(k_) = yr_.head(k_);
   out.segment(k_, nv_ - k_).setZero();
   applyQ(out);
 }
@@ -399,22 +415,23 @@ void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::colRot(int i, int j, double c, 
 }
 
 template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::gColRot(int i, int j, double c, double s,
+                                                         int rows) {
+  for (int l = 0; l < rows; ++l) {
+    const double a = AQ_(l, i), b = AQ_(l, j);
+    AQ_(l, i) = c * a + s * b;
+    AQ_(l, j) = -s * a + c * b;
+  }
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
 void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::rowRot(int i, int j, double c, double s,
                                                         int zfrom) {
   // row_i ← c row_i + s row_j,  row_j ← −s row_i + c row_j  (U ← U Gᵀ); G is
-  // row-major, so both segments are contiguous.
-  double* gi = &AQ_(i, 0);
-  double* gj = &AQ_(j, 0);
-  for (int l = 0; l < k_; ++l) {
-    const double a = gi[l], b = gj[l];
-    gi[l] = c * a + s * b;
-    gj[l] = -s * a + c * b;
-  }
-  for (int l = k_ + zfrom; l < nv_; ++l) {
-    const double a = gi[l], b = gj[l];
-    gi[l] = c * a + s * b;
-    gj[l] = -s * a + c * b;
-  }
+  // row-major, so both segments are contiguous (Eigen's vectorized plane rotation).
+  const Eigen::JacobiRotation<double> g(c, s);
+  if (k_ > 0) AQ_.leftCols(k_).applyOnTheLeft(i, j, g);
+  if (nv_ > k_ + zfrom) AQ_.middleCols(k_ + zfrom, nv_ - k_ - zfrom).applyOnTheLeft(i, j, g);
   const double ci = cU_(i), cj = cU_(j);
   cU_(i) = c * ci + s * cj;
   cU_(j) = -s * ci + c * cj;
@@ -423,26 +440,50 @@ void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::rowRot(int i, int j, double c, 
 template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
 void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::establishStructure() {
   // Bring G_Z = G(:, k:) to [T 0; 0 0] once; afterwards every working-set change
-  // keeps it with O((n + m)(nz + m)) rotations.
+  // keeps it with O((n + m)(nz + m)) rotations. Q may still be implicit (a cold start).
   const int nz = nv_ - k_;
   trap_ = true;
-  if (mc_ == 0 || nz == 0) return;
-  if (nz > mc_) {
-    // Wide: reflectors from the right, row by row: G_Z = [L 0], L lower triangular.
-    for (int i = 0; i < mc_; ++i) {
-      const int len = nz - i;
-      hv_.head(len) = AQ_.row(i).segment(k_ + i, len).transpose();
-      double tau = 0.0, beta = 0.0;
-      hv_.head(len).makeHouseholderInPlace(tau, beta);
-      if (len > 1) {
-        AQ_.block(i, k_ + i, mc_ - i, len)
-            .applyHouseholderOnTheRight(hv_.segment(1, len - 1), tau, work_.data());
-        Q_.block(0, k_ + i, nv_, len)
-            .applyHouseholderOnTheRight(hv_.segment(1, len - 1), tau, work_.data());
+  if (mc_ > 0 && nz > mc_) {
+    // Wide: reflectors from the right on the rows of G taken bottom-up, G_Z W = J [L 0]
+    // (J reverses the rows, L lower triangular), so J L is upper anti-triangular and
+    // reversing the first mc Z columns makes it the upper triangular T: no reflectors
+    // from the left. The rows go 8 at a time through a local block as in
+    // addRowsImplicit(); the reflectors are kept like those of an implicit Q (Hv_, htau_
+    // at k.., free once Q is explicit) and Q gets them all in one pass.
+    for (int s0 = 0; s0 < mc_; s0 += 8) {
+      const int h = std::min(8, mc_ - s0);
+      for (int l = 0; l < 8; ++l) {
+        if (l < h) strip_.row(l).head(nv_) = AQ_.row(mc_ - 1 - s0 - l).head(nv_);
+        else strip_.row(l).head(nv_).setZero();
       }
-      AQ_.row(i).segment(k_ + i + 1, len - 1).setZero();  // exact zeros
+      detail::reflectStrip<NV>(strip_, nv_, Hv_, htau_, k_, k_ + s0);
+      for (int l = 0; l < h; ++l) {
+        const int c0 = k_ + s0 + l, len = nv_ - c0;  // len ≥ nz − mc + 1 ≥ 2
+        double tau = 0.0, beta = 0.0;
+        auto v = Hv_.col(c0).segment(c0, len);
+        v = strip_.row(l).segment(c0, len).transpose();
+        v.makeHouseholderInPlace(tau, beta);
+        htau_(c0) = tau;
+        if (l + 1 < h) detail::reflectStrip<NV>(strip_, nv_, Hv_, htau_, c0, c0 + 1);
+        strip_(l, c0) = beta;  // what H_c0 made of row l, with exact zeros
+        strip_.row(l).segment(c0 + 1, len - 1).setZero();
+      }
+      for (int l = 0; l < h; ++l) AQ_.row(mc_ - 1 - s0 - l).head(nv_) = strip_.row(l).head(nv_);
     }
+    if (qexplicit_) {
+      detail::reflectRowStrips<NV>(Q_, nv_, nv_, Hv_, htau_, k_, k_ + mc_);
+    } else {
+      formQ(k_ + mc_);  // Q = H_0 ⋯ H_{k−1} W_k ⋯ W_{k+mc−1}
+      qexplicit_ = true;
+    }
+    for (int t = 0; t < mc_ / 2; ++t) {
+      Q_.col(k_ + t).head(nv_).swap(Q_.col(k_ + mc_ - 1 - t).head(nv_));
+      AQ_.col(k_ + t).head(mc_).swap(AQ_.col(k_ + mc_ - 1 - t).head(mc_));
+    }
+    return;
   }
+  ensureExplicit();
+  if (mc_ == 0 || nz == 0) return;
   // Reflectors from the left (QR of the first r columns of G_Z): T upper triangular.
   const int r = nz < mc_ ? nz : mc_;
   for (int i = 0; i < r; ++i) {
@@ -460,58 +501,69 @@ void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::establishStructure() {
 
 template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
 void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addRowStructured(double rhs) {
-  // Givens bottom-up on w(k:) (w_ = Qᵀ a is set): each column rotation (j−1, j) of
-  // G_Z makes one subdiagonal fill (j, j−1), removed at once by a row rotation.
+  // w_ = Qᵀ a is set. Its Z part is rotated into one Z column, the target, which then
+  // moves to position k (joins Q₁). The target is the last column of T (tall case) or
+  // the first all-zero column r (wide case, after one reflector on Q alone gathers w over
+  // the zero columns): rotations run left to right, each column rotation (j, j+1) of T
+  // fills (j+1, j), removed at once by a row rotation, and taking out the target column
+  // leaves T upper triangular. One sweep (a bottom-up sweep into the first Z column
+  // needed a second one to restore T after that column left).
   const int nz = nv_ - k_;
   const int r = nz < mc_ ? nz : mc_;
-  int top = nv_ - 1;
-  if (nz - r > 1) {
-    // Z columns r.. are zero in G: one reflector on Q alone clears w(k+r+1:).
+  int last = nz - 1;  // local index of the target column
+  if (nz > r) {
+    last = r;
     const int len = nz - r;
-    double tau = 0.0, beta = 0.0;
-    w_.segment(k_ + r, len).makeHouseholderInPlace(tau, beta);
-    Q_.block(0, k_ + r, nv_, len)
-        .applyHouseholderOnTheRight(w_.segment(k_ + r + 1, len - 1), tau, work_.data());
-    w_(k_ + r) = beta;
-    w_.segment(k_ + r + 1, len - 1).setZero();
-    top = k_ + r;
-  }
-  for (int i = top; i > k_; --i) {
-    const double wp = w_(i - 1), wq = w_(i);
-    if (wq == 0.0) continue;
-    const double rho = detail::hyp(wp, wq);
-    const double c = wp / rho, s = wq / rho;
-    w_(i - 1) = rho;
-    w_(i) = 0.0;
-    const int jl = i - k_;  // local index of column i in Z
-    if (jl - 1 >= r) {      // both columns of G_Z are zero: only Q turns
-      const Eigen::JacobiRotation<double> g(c, -s);
-      Q_.topLeftCorner(nv_, nv_).applyOnTheRight(i - 1, i, g);
-      continue;
+    if (len > 1) {
+      double tau = 0.0, beta = 0.0;
+      w_.segment(k_ + r, len).makeHouseholderInPlace(tau, beta);
+      Q_.block(0, k_ + r, nv_, len)
+          .applyHouseholderOnTheRight(w_.segment(k_ + r + 1, len - 1), tau, work_.data());
+      w_(k_ + r) = beta;
+      w_.segment(k_ + r + 1, len - 1).setZero();
     }
-    colRot(i - 1, i, c, s);
-    if (jl < mc_) {
-      const double a = AQ_(jl - 1, i - 1), b = AQ_(jl, i - 1);
+  }
+  // The rotations of Q depend on w alone: recorded, applied in one chain at the end. G
+  // gets each at once (its row rotation depends on it).
+  for (int j = 0; j < last; ++j) {
+    const int i = k_ + j;
+    const double wi = w_(i), wj = w_(i + 1);
+    rc_(i) = 1.0;
+    rs_(i) = 0.0;
+    if (wi == 0.0) continue;
+    const double rho = detail::hyp(wi, wj);
+    const double c = wj / rho, s = -wi / rho;  // (w_i, w_i+1) → (0, ρ)
+    rc_(i) = c;
+    rs_(i) = s;
+    w_(i) = 0.0;
+    w_(i + 1) = rho;
+    // Columns j, j+1 of G_Z: rows > j+1 are zero (and row j+1 of column j).
+    const bool fill = j + 1 < r;  // column j+1 has a diagonal entry of T
+    gColRot(i, i + 1, c, s, fill ? j + 2 : j + 1);
+    if (fill) {
+      const double a = AQ_(j, i), b = AQ_(j + 1, i);
       if (b != 0.0) {
         const double rr = detail::hyp(a, b);
-        rowRot(jl - 1, jl, a / rr, b / rr, jl - 1);
-        AQ_(jl, i - 1) = 0.0;
+        rowRot(j, j + 1, a / rr, b / rr, j);
+        AQ_(j + 1, i) = 0.0;
       }
     }
   }
-  for (int i = 0; i <= k_; ++i) R_(i, k_) = w_(i);
+  // Q: the chain, storing each column one to the right and the target at k; G likewise.
+  if (last > 0) {
+    detail::rotationChain<detail::RotationChain::UpShift>(Q_, nv_, k_, k_ + last, rc_, rs_);
+    for (int l = 0; l < mc_; ++l) {
+      double* g = &AQ_(l, k_);
+      const double t = g[last];
+      for (int j = last; j > 0; --j) g[j] = g[j - 1];
+      g[0] = t;
+    }
+  }
+  for (int i = 0; i < k_; ++i) R_(i, k_) = w_(i);
+  R_(k_, k_) = w_(k_ + last);
   R_.col(k_).segment(k_ + 1, nv_ - k_ - 1).setZero();
   rhs_(k_) = rhs;
   ++k_;
-  // The old first Z column left: G_Z is upper Hessenberg; row rotations restore T.
-  const int nz2 = nz - 1;
-  for (int j = 0; j < nz2 && j + 1 < mc_; ++j) {
-    const double a = AQ_(j, k_ + j), b = AQ_(j + 1, k_ + j);
-    if (b == 0.0) continue;
-    const double rr = detail::hyp(a, b);
-    rowRot(j, j + 1, a / rr, b / rr, j);
-    AQ_(j + 1, k_ + j) = 0.0;
-  }
 }
 
 template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
@@ -561,6 +613,7 @@ void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::removeRow(int pos) {
     givens(j, c, s);
   }
   --k_;
+  if (ny_ > pos) ny_ = pos;
   for (int i = 0; i < nv_; ++i) R_(i, k_) = 0.0;
   if (trap_) restoreAfterRemove();
   // Keep the inequality bookkeeping in K order.
@@ -609,6 +662,25 @@ void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addWarmRows(int nw_prev) {
     cand_upper_(cnt) = up ? 1 : 0;
     ++cnt;
   }
+  addRowsImplicit(
+      cnt, [this](int l, int c) { return Cs_(cand_row_(l), c); },
+      [this](int l) { return cand_upper_(l) ? us_(cand_row_(l)) : ls_(cand_row_(l)); },
+      [this](int l, bool held) {
+        const int j = cand_row_(l);
+        if (!held) {
+          in_ws_(j) = 0;  // dependent on K: not held
+          return;
+        }
+        ws_row_(nw_) = j;
+        ws_upper_(nw_) = cand_upper_(l);
+        ++nw_;
+      });
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+template <class Row, class Rhs, class Held>
+void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addRowsImplicit(int cnt, Row row, Rhs rhs,
+                                                                 Held held) {
   const int k0 = k_;
   const double tol2 = settings_.rank_tol * settings_.rank_tol;
   // Candidates 8 at a time in a local block (one row per lane): all reflectors so far
@@ -618,17 +690,16 @@ void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addWarmRows(int nw_prev) {
     const int h = std::min(8, cnt - s0);
     strip_.leftCols(nv_).setZero();
     for (int l = 0; l < h; ++l)
-      for (int c = 0; c < n_; ++c) strip_(l, c) = Cs_(cand_row_(s0 + l), c);
+      for (int c = 0; c < n_; ++c) strip_(l, c) = row(s0 + l, c);
     detail::reflectStrip<NV>(strip_, nv_, Hv_, htau_, 0, k_);
     for (int l = 0; l < h; ++l) {
-      const int j = cand_row_(s0 + l);
       const int nz = nv_ - k_;
       double an2 = 0.0;
-      for (int c = 0; c < n_; ++c) an2 += Cs_(j, c) * Cs_(j, c);
+      for (int c = 0; c < n_; ++c) an2 += row(s0 + l, c) * row(s0 + l, c);
       for (int c = 0; c < nv_; ++c) w_(c) = strip_(l, c);
       const double wn2 = nz > 0 ? w_.segment(k_, nz).squaredNorm() : 0.0;
-      if (nz <= 0 || !(wn2 > tol2 * an2) || an2 == 0.0) {  // dependent on K: not held
-        in_ws_(j) = 0;
+      if (nz <= 0 || !(wn2 > tol2 * an2) || an2 == 0.0) {
+        held(s0 + l, false);
         continue;
       }
       double tau = 0.0, beta = 0.0;
@@ -642,10 +713,8 @@ void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addWarmRows(int nw_prev) {
       R_.col(k_).head(k_) = w_.head(k_);
       R_(k_, k_) = beta;
       R_.col(k_).segment(k_ + 1, nv_ - k_ - 1).setZero();
-      rhs_(k_) = cand_upper_(s0 + l) ? us_(j) : ls_(j);
-      ws_row_(nw_) = j;
-      ws_upper_(nw_) = cand_upper_(s0 + l);
-      ++nw_;
+      rhs_(k_) = rhs(s0 + l);
+      held(s0 + l, true);
       ++k_;
       if (tau != 0.0 && l + 1 < h) detail::reflectStrip<NV>(strip_, nv_, Hv_, htau_, k_ - 1, k_);
     }
@@ -706,25 +775,35 @@ void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::startPhase(bool phase1) {
   trap_ = false;
   changes_ = 0;
   k_ = 0;
+  ny_ = 0;
   neq_ = 0;
   for (int j = 0; j < mi_; ++j) in_ws_(j) = 0;
 }
 
 template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
 bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addEqualities() {
-  const int nw_keep = nw_;
-  nw_ = 0;
-  for (int i = 0; i < me_; ++i) {
-    for (int c = 0; c < n_; ++c) a_(c) = Es_(i, c);
-    if (nv_ > n_) a_(n_) = 0.0;
-    eq_indep_(i) = 0;
-    if (addRowVector(es_(i))) {
-      eq_indep_(i) = 1;
-      eq_pos_(neq_) = i;
-      ++neq_;
+  if (qexplicit_ || trap_ || k_ != 0) {  // not the state after startPhase()
+    const int nw_keep = nw_;
+    nw_ = 0;
+    for (int i = 0; i < me_; ++i) {
+      for (int c = 0; c < n_; ++c) a_(c) = Es_(i, c);
+      if (nv_ > n_) a_(n_) = 0.0;
+      eq_indep_(i) = 0;
+      if (addRowVector(es_(i))) {
+        eq_indep_(i) = 1;
+        eq_pos_(neq_) = i;
+        ++neq_;
+      }
     }
+    nw_ = nw_keep;
+  } else {
+    addRowsImplicit(
+        me_, [this](int l, int c) { return Es_(l, c); }, [this](int l) { return es_(l); },
+        [this](int l, bool indep) {
+          eq_indep_(l) = indep ? 1 : 0;
+          if (indep) eq_pos_(neq_++) = l;
+        });
   }
-  nw_ = nw_keep;
   // Consistency of the dependent rows: residual at the minimum-norm point.
   if (neq_ == me_) return true;
   minNormPoint(xs_);  // scratch: xs_ (xc_ holds the iterate)
@@ -739,10 +818,8 @@ bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addEqualities() {
 template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
 bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::subproblem() {
   // x_p = Q₁ R⁻ᵀ rhs: the minimum-norm point of K x = rhs.
-  for (int i = 0; i < k_; ++i) {
-    // dot products (vectorized), not a serial chain of scalar updates
-    y_(i) = (rhs_(i) - R_.col(i).head(i).dot(y_.head(i))) / R_(i, i);
-  }
+  solveRt();
+  y_.head(k_) = yr_.head(k_);
   const int nz = nv_ - k_;
   // r = b − A x_p = b − (A Q₁) y ;  M = A Z = (A Q)(:, k:)
   if (mc_ > 0) {
@@ -756,12 +833,18 @@ bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::subproblem() {
       if (trap_) {
         // G_Z = [T 0; 0 0]: p = [T⁻¹ r̃(0:r); 0] is the minimum-norm minimizer.
         done = true;
-        for (int i = 0; i < r; ++i) done = done && std::abs(AQ_(i, k_ + i)) > tol;
+        for (int i = 0; i < r; ++i) {
+          const double t = AQ_(i, k_ + i);
+          done = done && std::abs(t) > tol;
+          dinv_(i) = 1.0 / t;  // independent divisions, off the solve's dependency chain
+        }
         if (done) {
+          // By columns: the dependency chain is one multiply and one FMA per entry
+          // (a dot product per row ends in a horizontal reduction each).
           for (int i = r - 1; i >= 0; --i) {
-            const double sum =
-                r_(i) - AQ_.row(i).segment(k_ + i + 1, r - i - 1).dot(p_.segment(i + 1, r - i - 1));
-            p_(i) = sum / AQ_(i, k_ + i);
+            const double pi = r_(i) * dinv_(i);
+            p_(i) = pi;
+            for (int l = 0; l < i; ++l) r_(l) -= pi * AQ_(l, k_ + i);
           }
           p_.segment(r, nz - r).setZero();
         }
@@ -835,6 +918,10 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
   // Ĉ x; skipped when the caller's feasibility check just computed it at this xc_.
   if (mi_ > 0 && !cx_at_xc_) cx_.head(mi_).noalias() = Cs_.topLeftCorner(mi_, n_) * xc_.head(n_);
   cx_at_xc_ = false;
+  // A cold start (K = equalities only) almost always changes K many times: set up the
+  // two-sided structure now, so that no subproblem needs the generic decomposition. Not
+  // on a warm start whose kept working set is empty: that one usually changes nothing.
+  if (cold_ && nw_ == 0 && mi_ > 0 && !trap_ && !phase1) establishStructure();
   for (;;) {
     if (!xs_fresh_ && !subproblem()) return QpStatus::NumericalFailure;
     xs_fresh_ = false;
@@ -949,6 +1036,7 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::solveImpl(const VectorX* x_
   cx_at_xc_ = false;
   for (int i = 0; i < me_; ++i) lam_eq_(i) = 0.0;
   const bool warm = warm_start && have_ws_;
+  cold_ = !warm;
   const int nw_prev = nw_;
   if (!prepare()) {
     x_.setZero(n_);

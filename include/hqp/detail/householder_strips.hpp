@@ -1,4 +1,5 @@
 #pragma once
+// Strip kernels for the small orthogonal updates of the QP and the null space.
 // Y ← Y H_first ⋯ H_{last−1} for a column-major Y, with H_i = I − τ_i v_i v_iᵀ and
 // v_i = [0 (i entries); 1; V(i+1 : cols, i)] (Eigen's / LAPACK's reflector storage).
 // Used for the rows below a level (HqpWbc, via NullSpace) and the QP's working-set rows.
@@ -69,6 +70,42 @@ inline void reflectRowStrips(MatY&& Y, int rows, int cols, const MatV& V, const 
       for (int j = first; j < cols; ++j) Y.col(j).segment(r0, h) = strip.col(j).head(h);
     }
   }
+}
+
+// A chain of plane rotations of the columns of a column-major Y (rows [0, rows)), each
+// rotation sharing one column with the next (x' = c x + s y, y' = −s x + c y for the
+// pair (x, y)). The shared column stays in registers, 8 rows at a time, so each rotation
+// costs one load and one store per 8 rows instead of two of each (and no call per
+// rotation):
+//   Up:      pairs (j, j + 1) for j = first, …, last − 1   (c(j), s(j))
+//   UpShift: as Up, but column j is stored at j + 1 and the final column last at first
+//            (the rotated columns shifted right by one, the last one moved to the front).
+enum class RotationChain { Up, UpShift };
+
+template <RotationChain K, int L, class MatY, class VecCs>
+inline void rotationChainBlock(MatY& Y, int r0, int first, int last, const VecCs& c,
+                               const VecCs& s) {
+  using Vec = Eigen::Matrix<double, L, 1>;
+  constexpr int shift = K == RotationChain::UpShift ? 1 : 0;
+  Vec x = Y.col(first).template segment<L>(r0);  // carried: column j
+  for (int j = first; j < last; ++j) {
+    const Vec y = Y.col(j + 1).template segment<L>(r0);
+    Y.col(j + shift).template segment<L>(r0) = c(j) * x + s(j) * y;
+    x = c(j) * y - s(j) * x;
+  }
+  Y.col(shift ? first : last).template segment<L>(r0) = x;
+}
+
+template <RotationChain K, class MatY, class VecCs>
+inline void rotationChain(MatY& Y, int rows, int first, int last, const VecCs& c,
+                          const VecCs& s) {
+  constexpr int MaxRowsY = MatY::MaxRowsAtCompileTime;
+  int r0 = 0;
+  if constexpr (MaxRowsY == Eigen::Dynamic || MaxRowsY >= 8)
+    for (; r0 + 8 <= rows; r0 += 8) rotationChainBlock<K, 8>(Y, r0, first, last, c, s);
+  if constexpr (MaxRowsY == Eigen::Dynamic || MaxRowsY >= 4)
+    for (; r0 + 4 <= rows; r0 += 4) rotationChainBlock<K, 4>(Y, r0, first, last, c, s);
+  for (; r0 < rows; ++r0) rotationChainBlock<K, 1>(Y, r0, first, last, c, s);
 }
 
 }  // namespace hqp::detail
