@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -164,6 +165,17 @@ class DualActiveSetQp {
         dropActive(drop);
       }
     }
+  }
+
+  // Warm start from a primal solver's working set (ActiveSetQp's numActive/activeRow,
+  // variables/hasWorkingSet): if it belongs to a problem of n variables, its first rows (at
+  // most MaxN) are written to rows, to be passed to solve() as prefer. Returns their count.
+  template <class WorkingSet, class Rows>
+  static int preferredRows(const WorkingSet& ws, int n, Rows& rows) {
+    if (!ws.hasWorkingSet() || ws.variables() != n) return 0;
+    const int count = std::min(ws.numActive(), static_cast<int>(rows.size()));
+    for (int a = 0; a < count; ++a) rows[static_cast<std::size_t>(a)] = ws.activeRow(a);
+    return count;
   }
 
   const VectorX& x() const { return x_; }

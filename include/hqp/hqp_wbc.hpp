@@ -541,11 +541,7 @@ class HqpWbc {
     }
     // The level's working set (the previous tick's active set, or a recorded one) goes first.
     auto& qp = std::get<P>(qps_);
-    int prefer = 0;
-    if (settings_.warm_start && qp.hasWorkingSet() && qp.variables() == n) {
-      prefer = std::min(qp.numActive(), Nx);
-      for (int a = 0; a < prefer; ++a) prefer_[static_cast<std::size_t>(a)] = qp.activeRow(a);
-    }
+    const int prefer = settings_.warm_start ? DualQp::preferredRows(qp, n, prefer_) : 0;
     if (dual_.solve(Cw, dlo_, dup_, c, settings_.qp, prefer_.data(), prefer) != QpStatus::Optimal)
       return false;
     u_ = dual_.x();

@@ -153,11 +153,7 @@ class WqpWbc {
       const double min_sigma = std::sqrt(static_cast<double>(total_task_rows)) *
                                qp_.settings().rank_tol * qp_.A().norm();
       if (!dual_.factorize(qp_.A(), qp_.b(), total_task_rows, Nx, min_sigma)) return false;
-      int prefer = 0;
-      if (warm_start_ && qp_.hasWorkingSet() && qp_.variables() == Nx) {
-        prefer = std::min(qp_.numActive(), Nx);
-        for (int a = 0; a < prefer; ++a) prefer_[static_cast<std::size_t>(a)] = qp_.activeRow(a);
-      }
+      const int prefer = warm_start_ ? DualQp::preferredRows(qp_, Nx, prefer_) : 0;
       const QpStatus s = dual_.solve(qp_.C(), qp_.lower(), qp_.upper(), total_constraint_rows,
                                      qp_.settings(), prefer_.data(), prefer);
       if (s != QpStatus::Optimal) return false;
