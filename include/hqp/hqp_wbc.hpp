@@ -523,16 +523,11 @@ class HqpWbc {
     if (!dual_.factorize(M_, bq_, r, n, min_sigma)) return false;
     const auto Cw = W_.block(total_task_rows, col0, c, n);
     cnorm_.head(c) = Cw.rowwise().squaredNorm();
-    const double tol = settings_.qp.feasibility_tol;
     for (int i = 0; i < c; ++i) {
       double lo = lower_(i) - dx_(i), up = upper_(i) - dx_(i);
-      if (i < c0) {  // as neutralizeLockedRows: u = 0 exactly feasible for higher rows
-        lo = std::min(lo, 0.0);
-        up = std::max(up, 0.0);
-      }
-      if (std::sqrt(cnorm_(i)) <= settings_.rank_tol * Dnorm_(i)) {  // locked by higher levels
-        const double sc = rowScale(Dnorm_(i));
-        if (i >= c0 && (lo / sc > tol || -up / sc > tol)) return false;
+      widenHigherRow(i, c0, lo, up);
+      if (lockedRow(i, cnorm_(i))) {
+        if (i >= c0 && !lockedRowHolds(i, lo, up)) return false;
         lo = -kInf;
         up = kInf;
       }
@@ -614,10 +609,7 @@ class HqpWbc {
     const double tol2 = settings_.qp.feasibility_tol * settings_.qp.feasibility_tol;
     for (int i = 0; i < c; ++i) {
       double lo = lower_(i) - dx_(i), up = upper_(i) - dx_(i);
-      if (i < c0) {
-        lo = std::min(lo, 0.0);
-        up = std::max(up, 0.0);
-      }
+      widenHigherRow(i, c0, lo, up);
       const double v = tmp_(i);
       const double viol = std::max(lo - v, v - up);
       // The row's norm only where a bound is crossed (most rows are strictly inside).
@@ -636,19 +628,11 @@ class HqpWbc {
   template <class Qp>
   bool neutralizeLockedRows(Qp& qp, int c, int own_begin) {
     bool infeasible = false;
-    const double tol = settings_.qp.feasibility_tol;
     cnorm_.head(c) = qp.C().rowwise().squaredNorm();  // all rows at once (vectorized)
     for (int i = 0; i < c; ++i) {
-      const double dn = Dnorm_(i);
-      if (i < own_begin) {
-        // x*_{p−1} met this higher row up to the QP's tolerance; make u = 0 exactly feasible
-        // (a rounding-size empty interval at a degenerate vertex would stall the QP).
-        qp.lower()(i) = std::min(qp.lower()(i), 0.0);
-        qp.upper()(i) = std::max(qp.upper()(i), 0.0);
-      }
-      if (std::sqrt(cnorm_(i)) > settings_.rank_tol * dn) continue;
-      const double sc = rowScale(dn);
-      const bool ok = qp.lower()(i) / sc <= tol && -qp.upper()(i) / sc <= tol;
+      widenHigherRow(i, own_begin, qp.lower()(i), qp.upper()(i));
+      if (!lockedRow(i, cnorm_(i))) continue;
+      const bool ok = lockedRowHolds(i, qp.lower()(i), qp.upper()(i));
       qp.C().row(i).setZero();
       if (ok || i < own_begin) {
         qp.lower()(i) = -kInf;
@@ -658,6 +642,23 @@ class HqpWbc {
       }
     }
     return infeasible;
+  }
+
+  // The rules every consumer of a level's shifted bounds (lower − D x*_{p−1}, upper − D x*_{p−1})
+  // shares (neutralizeLockedRows, freeStep, dualLastLevel). A higher row (i < own_begin) is
+  // widened to contain 0: x*_{p−1} met it up to the QP's tolerance, and a rounding-size empty
+  // interval at a degenerate vertex would stall the QP.
+  static void widenHigherRow(int i, int own_begin, double& lo, double& up) {
+    if (i >= own_begin) return;
+    lo = std::min(lo, 0.0);
+    up = std::max(up, 0.0);
+  }
+  // Row i is locked by the higher levels if its reduced row (squared norm rn2) is ≤ rank_tol ‖D_i‖.
+  bool lockedRow(int i, double rn2) const { return std::sqrt(rn2) <= settings_.rank_tol * Dnorm_(i); }
+  // A locked row holds at x*_{p−1} if its shifted bounds contain 0 up to the QP's tolerance.
+  bool lockedRowHolds(int i, double lo, double up) const {
+    const double sc = rowScale(Dnorm_(i)), tol = settings_.qp.feasibility_tol;
+    return lo / sc <= tol && -up / sc <= tol;
   }
 
   // Own bound violation Σ over rows of max(lower − d, d − upper, 0)² for d = D_own x.
