@@ -69,7 +69,14 @@ class BalanceDriver final : public Driver {
       h += p + "_in_contact" + p + "_following" + p + "_zmp_meas_x" + p + "_zmp_meas_y" + p + "_zmp_opt_x" + p +
            "_zmp_opt_y";
     }
-    return h + ",com_err_x,com_err_y,com_err_z,torso_err_x,torso_err_y,torso_err_z,current_saturated";
+    h += ",com_err_x,com_err_y,com_err_z,torso_err_x,torso_err_y,torso_err_z,current_saturated";
+    // State estimate (world axes): base velocity, per foot trust, moving flag, support velocity.
+    h += ",est_base_vx,est_base_vy,est_base_vz,est_accel_bias_x,est_accel_bias_y,est_accel_bias_z";
+    for (const char* f : {"l", "r"}) {
+      const std::string p = std::string(",") + f;
+      h += p + "_trust" + p + "_moving" + p + "_support_vx" + p + "_support_vy" + p + "_support_vz";
+    }
+    return h;
   }
   bool solverStatus(SolverStatus& st) const override {
     const auto& d = controller_->diagnostics();
@@ -91,6 +98,21 @@ class BalanceDriver final : public Driver {
     t.ddq_opt = x.template segment<kJoints>(6);
     return true;
   }
+  bool estimate(EstimateSample& e) const override {
+    if (controller_->diagnostics().mode != hqp::tasks::ControllerMode::Balance) return false;
+    const auto& est = controller_->estimator();
+    const auto& q = est.q();
+    e.base_position = q.template head<3>();
+    e.base_orientation = Eigen::Quaterniond(q[3], q[4], q[5], q[6]);
+    e.base_velocity = e.base_orientation * Eigen::Vector3d(est.v().template head<3>());
+    e.com = controller_->dynamics().com();
+    e.com_velocity = controller_->dynamics().vcom();
+    for (int c = 0; c < kContacts; ++c) {
+      e.in_contact[c] = est.inContact(c);
+      e.support_velocity[c] = est.supportVelocity(c);
+    }
+    return true;
+  }
   void logRow(std::FILE* f) const override {
     const auto& d = controller_->diagnostics();
     std::fprintf(f, ",%d", static_cast<int>(d.status));
@@ -101,6 +123,16 @@ class BalanceDriver final : public Driver {
     }
     std::fprintf(f, ",%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d", d.com_error.x(), d.com_error.y(), d.com_error.z(),
                  d.torso_error.x(), d.torso_error.y(), d.torso_error.z(), d.current_saturated ? 1 : 0);
+    const auto& est = controller_->estimator();
+    const auto& q = est.q();
+    const Eigen::Vector3d vb =
+        Eigen::Quaterniond(q[3], q[4], q[5], q[6]) * Eigen::Vector3d(est.v().template head<3>());
+    const Eigen::Vector3d ab = est.accelerometerBias();
+    std::fprintf(f, ",%.5f,%.5f,%.5f,%.5f,%.5f,%.5f", vb.x(), vb.y(), vb.z(), ab.x(), ab.y(), ab.z());
+    for (int c = 0; c < kContacts; ++c) {
+      const Eigen::Vector3d& vs = est.supportVelocity(c);
+      std::fprintf(f, ",%.3f,%d,%.5f,%.5f,%.5f", est.footTrust(c), est.footMoving(c) ? 1 : 0, vs.x(), vs.y(), vs.z());
+    }
   }
 
   bool startRecording(const RecordOptions& o) {
@@ -143,6 +175,9 @@ std::unique_ptr<Driver> makeBalanceController(const std::string& config_path, bo
   auto& joint = config.joint;
   if (overrides.k_f >= 0.0) joint.k_f.setConstant(overrides.k_f);
   joint.k_dq *= overrides.kinematic_compensation;
+  using Method = hqp::tasks::EstimatorParameters::Method;
+  if (overrides.estimator == "stance") config.estimator.method = Method::Stance;
+  else if (overrides.estimator == "kinematic_inertial") config.estimator.method = Method::KinematicInertial;
   for (int j = 0; j < kJoints; ++j) {
     auto& f = joint.friction[static_cast<std::size_t>(j)];
     if (overrides.plant_friction) {

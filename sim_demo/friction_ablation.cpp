@@ -61,6 +61,7 @@ ControllerOverrides controllerOverrides(const ScenarioParams& p, const PlantConf
   o.plant_friction = p.friction_model == "plant";
   o.friction_model_scale = p.friction_model_scale;
   o.kinematic_compensation = p.kinematic_compensation;
+  o.estimator = p.estimator;
   if (o.plant_friction) {
     for (int i = 0; i < kJoints; ++i) {
       const JointPlant& j = plant.joint(Robot::bodies[i + 1].joint);

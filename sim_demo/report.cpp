@@ -110,6 +110,18 @@ nlohmann::ordered_json runRecord(const ScenarioParams& p, const RunSummary& r) {
   }
   j["level_status_counts"] = levels;
   j["safe_mode_ticks"] = r.safe_mode_ticks;
+  if (r.estimator.available) {
+    const auto& a = r.estimator;
+    auto stat = [](const ErrorStats& e, double scale) {
+      return nlohmann::ordered_json{{"rms", num(e.rms * scale)}, {"max", e.n > 0 ? num(e.max * scale) : num(NAN)}};
+    };
+    j["estimator_error"] = {{"base_position_mm", stat(a.base_position, 1e3)},
+                            {"base_velocity_mm_s", stat(a.base_velocity, 1e3)},
+                            {"orientation_deg", stat(a.orientation, kDeg)},
+                            {"com_mm", stat(a.com, 1e3)},
+                            {"com_velocity_mm_s", stat(a.com_velocity, 1e3)},
+                            {"support_velocity_mm_s", stat(a.support_velocity, 1e3)}};
+  }
   j["feet_touch_s"] = r.feet_touch_ticks * 1e-3;
   j["tick_mean_us"] = r.tick_mean_us;
   j["tick_max_us"] = r.tick_max_us;
@@ -234,6 +246,18 @@ void printRecord(std::FILE* out, const nlohmann::ordered_json& j) {
     }
     std::fprintf(out, "\n  lowest-level error : max %.3g, mean %.3g (||A x - b||^2)\n",
                  j["lowest_level_error_max"].get<double>(), j["lowest_level_error_mean"].get<double>());
+  }
+  if (j.contains("estimator_error")) {
+    const auto& e = j["estimator_error"];
+    std::fprintf(out, "  estimator error    : RMS / max: base position %s / %s mm, base velocity %s / %s mm/s, "
+                      "orientation %s / %s deg, CoM %s / %s mm, CoM velocity %s / %s mm/s, support velocity %s / %s mm/s\n",
+                 fmtOr(e["base_position_mm"]["rms"], "%.1f").c_str(), fmtOr(e["base_position_mm"]["max"], "%.1f").c_str(),
+                 fmtOr(e["base_velocity_mm_s"]["rms"], "%.1f").c_str(), fmtOr(e["base_velocity_mm_s"]["max"], "%.1f").c_str(),
+                 fmtOr(e["orientation_deg"]["rms"], "%.2f").c_str(), fmtOr(e["orientation_deg"]["max"], "%.2f").c_str(),
+                 fmtOr(e["com_mm"]["rms"], "%.1f").c_str(), fmtOr(e["com_mm"]["max"], "%.1f").c_str(),
+                 fmtOr(e["com_velocity_mm_s"]["rms"], "%.1f").c_str(), fmtOr(e["com_velocity_mm_s"]["max"], "%.1f").c_str(),
+                 fmtOr(e["support_velocity_mm_s"]["rms"], "%.1f").c_str(),
+                 fmtOr(e["support_velocity_mm_s"]["max"], "%.1f").c_str());
   }
   std::fprintf(out, "  controller time    : mean %.1f us, max %.1f us, 99.9%% %.1f us (budget 1000 us)\n",
                j["tick_mean_us"].get<double>(), j["tick_max_us"].get<double>(), j["tick_p999_us"].get<double>());

@@ -48,7 +48,7 @@ class CsvLog {
     std::fprintf(f_, ",l_cop_x,l_cop_y,r_cop_x,r_cop_y,torso_pitch,torso_roll,torso_z,com_x,com_y,com_z,"
                      "l_foot_pitch,l_foot_roll,r_foot_pitch,r_foot_roll,push_fx,push_fy,push_fz,ball_px,ball_py,ball_pz,tick_us,safe_mode");
     // Moving supports: foot yaw and sole velocity (world), then each driven support's position.
-    std::fprintf(f_, ",l_foot_yaw,r_foot_yaw");
+    std::fprintf(f_, ",l_foot_yaw,r_foot_yaw,base_vx,base_vy,base_vz");
     for (const char* foot : {"l", "r"}) {
       for (const char* c : {"wx", "wy", "wz", "vx", "vy", "vz"}) std::fprintf(f_, ",%s_foot_%s", foot, c);
     }
@@ -79,6 +79,8 @@ class CsvLog {
     std::fprintf(f_, ",%.2f,%.2f,%.2f,%.4f,%.4f,%.4f,%.2f,%d", push.x(), push.y(), push.z(), ball.x(), ball.y(), ball.z(),
                  tick_us, safe ? 1 : 0);
     std::fprintf(f_, ",%.6f,%.6f", sim.footYaw(0), sim.footYaw(1));
+    const double* vb = sim.data()->qvel + sim.baseDofAdr();  // free joint: world linear
+    std::fprintf(f_, ",%.5f,%.5f,%.5f", vb[0], vb[1], vb[2]);
     for (int c = 0; c < kContacts; ++c) {
       const Vector6 v = sim.footVelocity(c);
       for (int k = 0; k < 6; ++k) std::fprintf(f_, ",%.5f", v[k]);
@@ -160,6 +162,9 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
   // leaves the robot. 0: idle, 1: flying, 2: touching the robot.
   int ball_state = 0;
   Eigen::Vector3d ball_p0 = Eigen::Vector3d::Zero();
+  EstimateSample est;
+  Eigen::Vector3d est_p0 = Eigen::Vector3d::Zero(), est_com0 = Eigen::Vector3d::Zero();
+  bool est_started = false;
   for (long k = 0; k < ticks; ++k) {
     sim.readSensors(s);
     const auto t0 = std::chrono::steady_clock::now();
@@ -167,6 +172,32 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
     const double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
     tick_us.push_back(us);
     if (driver.safeMode()) ++r.safe_mode_ticks;
+    if (driver.estimate(est)) {
+      // Truth of the state the sensors were read from (before this tick's step).
+      const mjData* d = sim.data();
+      const double* qp = d->qpos + sim.baseQposAdr();
+      const Eigen::Vector3d p_true(qp[0], qp[1], qp[2]);
+      const Eigen::Quaterniond quat_true(qp[3], qp[4], qp[5], qp[6]);
+      const Eigen::Vector3d v_true(d->qvel + sim.baseDofAdr());  // free joint: world-frame linear
+      mj_subtreeVel(sim.model(), sim.data());
+      const Eigen::Vector3d com_true = sim.centerOfMass(), vcom_true = sim.centerOfMassVelocity();
+      if (!est_started) {
+        est_p0 = est.base_position - p_true;
+        est_com0 = est.com - com_true;
+        est_started = true;
+      }
+      auto& a = r.estimator;
+      a.available = true;
+      a.base_position.add((est.base_position - est_p0 - p_true).norm());
+      a.base_velocity.add((est.base_velocity - v_true).norm());
+      a.orientation.add(est.base_orientation.angularDistance(quat_true));
+      a.com.add((est.com - est_com0 - com_true).norm());
+      a.com_velocity.add((est.com_velocity - vcom_true).norm());
+      for (int c = 0; c < kContacts; ++c) {
+        if (!est.in_contact[c] || !(sim.wrenchInSole(c, sim.trueForceTorque(c))[2] >= o.zmp_min_fz)) continue;
+        a.support_velocity.add((est.support_velocity[c] - sim.footVelocity(c).tail<3>()).norm());
+      }
+    }
     sim.applyCommand(cmd);
     for (std::size_t i = 0; i < o.supports.size(); ++i) {
       double q = 0.0, dq = 0.0;
@@ -308,6 +339,9 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
     r.zmp_tracking_rms[c] = zmp_tracked[c] > 0 ? std::sqrt(zmp_sq_sum[c] / zmp_tracked[c])
                                                : std::numeric_limits<double>::quiet_NaN();
   }
+  for (ErrorStats* e : {&r.estimator.base_position, &r.estimator.base_velocity, &r.estimator.orientation,
+                        &r.estimator.com, &r.estimator.com_velocity, &r.estimator.support_velocity})
+    e->finish();
   if (solver_ticks > 0) r.lowest_level_error_mean = lowest_error_sum / solver_ticks;
   if (tau_ticks > 0) {
     r.torque_tracking_rms = std::sqrt(r.torque_tracking_rms_joint.sum() / (kJoints * tau_ticks));

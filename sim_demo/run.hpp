@@ -2,13 +2,17 @@
 // One simulated run: the 1 kHz loop sensors -> driver (controller) -> currents -> plant, with a
 // CSV log, fall detection, timing and an optional video. Not real-time code.
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "simulation.hpp"
 #include "support_motion.hpp"
@@ -23,6 +27,36 @@ struct SolverStatus {
   std::array<int, kMaxLevels> level_status{};        // hqp::QpStatus as int
   std::array<double, kMaxLevels> level_residual{};   // ||A x - b||^2 of each level's tasks
   std::array<Eigen::Vector2d, kContacts> zmp_optimized;  // from F*, sole frame (m)
+};
+
+// The controller's state estimate of one tick, world frame, for the accuracy metrics.
+struct EstimateSample {
+  Eigen::Vector3d base_position = Eigen::Vector3d::Zero();   // m
+  Eigen::Vector3d base_velocity = Eigen::Vector3d::Zero();   // m/s, world axes
+  Eigen::Quaterniond base_orientation = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();              // m
+  Eigen::Vector3d com_velocity = Eigen::Vector3d::Zero();     // m/s
+  std::array<Eigen::Vector3d, kContacts> support_velocity;    // m/s, world; loaded feet only
+  std::array<bool, kContacts> in_contact{};
+};
+
+// RMS and largest error of one estimated quantity against MuJoCo's true state.
+struct ErrorStats {
+  double rms = 0, max = 0;
+  long n = 0;
+  void add(double e) {
+    rms += e * e;  // sum of squares until finish()
+    max = std::max(max, e);
+    ++n;
+  }
+  void finish() { rms = n > 0 ? std::sqrt(rms / n) : std::numeric_limits<double>::quiet_NaN(); }
+};
+
+// Estimator accuracy over a run (docs/controller.md, "State estimator"). Positions are compared
+// after removing the offset of the first tick (the estimator chooses its own world origin).
+struct EstimatorAccuracy {
+  bool available = false;
+  ErrorStats base_position, base_velocity, orientation, com, com_velocity, support_velocity;
 };
 
 struct JointTargets {
@@ -47,6 +81,8 @@ class Driver {
   // This tick's whole-body optimum as the joint level received it: τ_opt (eq. 6) and q̈*; false
   // for drivers without one (and in the controller's safe mode).
   virtual bool jointTargets(JointTargets&) const { return false; }
+  // This tick's state estimate; false for drivers without one (and in safe mode).
+  virtual bool estimate(EstimateSample&) const { return false; }
 };
 
 // Joint PD to the standing pose from encoder data only (the stand-in before the balance
@@ -64,6 +100,7 @@ struct ControllerOverrides {
   VectorJ viscous = VectorJ::Zero();       // N·m·s/rad, the plant's F_v (used with plant_friction)
   double friction_model_scale = 1.0;       // factor on the resulting F_c and F_v
   double kinematic_compensation = 1.0;     // factor on k_q̇ (eq. 8)
+  std::string estimator = "config";        // config, stance or kinematic_inertial
 };
 std::unique_ptr<Driver> makeBalanceController(const std::string& config_path, bool wqp,
                                               const ControllerOverrides& overrides = {});
@@ -147,6 +184,7 @@ struct RunSummary {
   // (what the robot withstood, not the fall), and its largest yaw change.
   std::array<Eigen::Vector3d, kContacts> foot_angular_velocity_peak, foot_linear_velocity_peak;
   std::array<double, kContacts> max_abs_foot_yaw{};
+  EstimatorAccuracy estimator;  // base_position/com (m), velocities (m/s), orientation (rad)
   bool passed = false;  // no fall, no safe mode, every loaded ZMP inside its sole (+ tolerance)
   std::string csv_path, video_path;
 };

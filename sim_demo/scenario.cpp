@@ -247,6 +247,13 @@ const std::vector<Parameter>& parameters() {
       {"kinematic_compensation", "factor on the controller's k_q̇ (eq. 8; 0: no kinematic compensation)",
        [](P& p, S k, S v) { p.kinematic_compensation = parseDouble(k, v, 0.0, 10.0); },
        [](const P& p) { return formatDouble(p.kinematic_compensation); }},
+      {"estimator", "controller's state estimator: config (controller YAML's), stance or kinematic_inertial",
+       [](P& p, S k, S v) {
+         if (v != "config" && v != "stance" && v != "kinematic_inertial")
+           badValue(k, v, "config, stance or kinematic_inertial");
+         p.estimator = v;
+       },
+       [](const P& p) { return p.estimator; }},
       {"ablation_scenarios", "friction_ablation: base scenarios (single-run presets)",
        [](P& p, S k, S v) {
          std::vector<std::string> names = split(v, ',');

@@ -50,6 +50,7 @@ struct ScenarioParams {
   std::string friction_model = "config";  // F_c, F_v: config (the YAML's) or plant (plant.yaml's, the truth)
   double friction_model_scale = 1.0;      // factor on those F_c and F_v
   double kinematic_compensation = 1.0;    // factor on the YAML's k_q̇ (eq. 8)
+  std::string estimator = "config";       // config (controller YAML's), stance or kinematic_inertial
   bool ablation = false;                  // friction_ablation: runs instead of one run
   AblationParams ablation_params;
   // Moving supports (issue 6): the scene file (in the directory of the default scene.xml) and

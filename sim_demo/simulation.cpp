@@ -309,6 +309,10 @@ Eigen::Vector3d Simulation::centerOfMass() const {
   return Eigen::Vector3d(d_->subtree_com + 3 * torso_);  // the robot is the torso's subtree
 }
 
+Eigen::Vector3d Simulation::centerOfMassVelocity() const {
+  return Eigen::Vector3d(d_->subtree_linvel + 3 * torso_);
+}
+
 bool Simulation::nonFootContact() const {
   for (int i = 0; i < d_->ncon; ++i) {
     const int b1 = m_->geom_bodyid[d_->contact[i].geom1], b2 = m_->geom_bodyid[d_->contact[i].geom2];

@@ -80,6 +80,7 @@ class Simulation {
   double controlDt() const { return options_.control_dt; }
   const mjModel* model() const { return m_; }
   mjData* data() { return d_; }
+  const mjData* data() const { return d_; }
   const PlantConfig& plant() const { return plant_; }
   const VectorJ& torqueConstant() const { return k_t_; }
   const VectorJ& standingPose() const { return q_stand_; }
@@ -96,6 +97,7 @@ class Simulation {
   double torsoPitch() const;                // rad, about world y (+: leaning forward)
   double torsoRoll() const;                 // rad, about world x
   Eigen::Vector3d centerOfMass() const;     // m, world
+  Eigen::Vector3d centerOfMassVelocity() const;  // m/s, world (valid after mj_subtreeVel)
   double footPitch(int c) const;            // rad, sole plate about world y
   double footRoll(int c) const;             // rad, sole plate about world x
   double footYaw(int c) const;              // rad, sole plate about world z

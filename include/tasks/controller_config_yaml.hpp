@@ -222,7 +222,8 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
   {
     const std::string p = "planner";
     const YAML::Node n = r.map(root, "", p, {"safe_margin", "com_height", "sole", "torso_yaw_offset",
-                                            "follow_acceleration_cutoff", "follow_translation"});
+                                            "follow_acceleration_cutoff", "follow_translation",
+                                            "com_reference_cutoff"});
     PlannerParameters& pl = c.planner;
     pl.safe_margin = r.atLeast(n, p, "safe_margin", 0.0, false);
     pl.com_height = r.finite(n, p, "com_height");
@@ -236,13 +237,56 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
     if (n["follow_acceleration_cutoff"])
       pl.follow_acceleration_cutoff = r.atLeast(n, p, "follow_acceleration_cutoff", 0.0, false);
     if (n["follow_translation"]) pl.follow_translation = r.boolean(n, p, "follow_translation");
+    if (n["com_reference_cutoff"])
+      pl.com_reference_cutoff = r.atLeast(n, p, "com_reference_cutoff", 0.0, false);
   }
   {
-    const YAML::Node n = r.map(root, "", "estimator", {"contact_threshold"});
-    c.estimator.contact_threshold = r.atLeast(n, "estimator", "contact_threshold", 0.0, true);
+    const std::string p = "estimator";
+    const YAML::Node n =
+        r.map(root, "", p,
+              {"method", "contact_threshold", "contact_on", "contact_full", "zero_velocity_gate", "stationary_velocity", "relative_velocity_gate", "gate_cutoff", "trust_delay",
+               "moving_velocity", "support_acceleration_cutoff", "quaternion_tolerance", "noise"});
+    EstimatorParameters& e = c.estimator;
+    e.contact_threshold = r.atLeast(n, p, "contact_threshold", 0.0, true);
     // A foot the QP still loads with fz_min must register as a support (docs/controller.md).
-    if (!(c.estimator.contact_threshold < c.balance.fz_min))
+    if (!(e.contact_threshold < c.balance.fz_min))
       r.fail("'estimator.contact_threshold' must be below 'balance.fz_min'");
+    // Optional keys: absent = the stance-foot estimator without hysteresis.
+    if (n["method"]) {
+      const std::string m = r.text(n, p, "method");
+      if (m == "stance") e.method = EstimatorParameters::Method::Stance;
+      else if (m == "kinematic_inertial") e.method = EstimatorParameters::Method::KinematicInertial;
+      else r.fail("'estimator.method' must be stance or kinematic_inertial, got '" + m + "'");
+    }
+    if (n["contact_on"]) {
+      e.contact_on = r.atLeast(n, p, "contact_on", 0.0, false);
+      if (!(e.contact_on < c.balance.fz_min)) r.fail("'estimator.contact_on' must be below 'balance.fz_min'");
+    }
+    if (n["contact_full"]) e.contact_full = r.atLeast(n, p, "contact_full", 0.0, false);
+    if (n["zero_velocity_gate"]) e.zero_velocity_gate = r.atLeast(n, p, "zero_velocity_gate", 0.0, true);
+    if (n["stationary_velocity"]) e.stationary_velocity = r.atLeast(n, p, "stationary_velocity", 0.0, true);
+    if (n["relative_velocity_gate"])
+      e.relative_velocity_gate = r.atLeast(n, p, "relative_velocity_gate", 0.0, true);
+    if (n["gate_cutoff"]) e.gate_cutoff = r.atLeast(n, p, "gate_cutoff", 0.0, false);
+    if (n["trust_delay"]) e.trust_delay = r.atLeast(n, p, "trust_delay", 0.0, false);
+    if (n["moving_velocity"]) e.moving_velocity = r.atLeast(n, p, "moving_velocity", 0.0, true);
+    if (n["support_acceleration_cutoff"])
+      e.support_acceleration_cutoff = r.atLeast(n, p, "support_acceleration_cutoff", 0.0, false);
+    if (n["quaternion_tolerance"]) e.quaternion_tolerance = r.atLeast(n, p, "quaternion_tolerance", 0.0, true);
+    if (n["noise"]) {
+      const std::string np = "estimator.noise";
+      const YAML::Node nn = r.map(n, p, "noise",
+                                  {"accel", "bias", "foot_stance", "foot_swing", "kinematic_position",
+                                   "zero_velocity", "fallback_velocity"});
+      KinematicInertialNoise& k = e.noise;
+      k.accel = r.atLeast(nn, np, "accel", 0.0, true);
+      k.bias = r.atLeast(nn, np, "bias", 0.0, false);
+      k.foot_stance = r.atLeast(nn, np, "foot_stance", 0.0, false);
+      k.foot_swing = r.atLeast(nn, np, "foot_swing", 0.0, true);
+      k.kinematic_position = r.atLeast(nn, np, "kinematic_position", 0.0, true);
+      k.zero_velocity = r.atLeast(nn, np, "zero_velocity", 0.0, true);
+      k.fallback_velocity = r.atLeast(nn, np, "fallback_velocity", 0.0, false);
+    }
   }
   {
     const std::string p = "joint_control";

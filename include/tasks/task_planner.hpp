@@ -17,6 +17,12 @@
 //     reference (the paper's hold, which stops a tipping foot) but its position, velocity and
 //     feed-forward acceleration references follow the foot's translation, so a board that
 //     carries the foot away is not fought by the level-2 task.
+// One extension beyond the paper for the CoM (docs/tasks.md, "CoM reference on moving supports";
+// off by default):
+//   com_reference_cutoff > 0: the CoM reference is the midpoint of the foot references after a
+//     first-order low-pass at this cutoff (and its velocity the low-passed midpoint's rate), so
+//     a board that oscillates one foot does not make the whole body chase the midpoint; a
+//     support that moves steadily is still followed, with the filter's lag.
 // Allocation-free and exception-free; see docs/tasks.md.
 
 #include <array>
@@ -45,6 +51,8 @@ struct PlannerParameters {
   double follow_acceleration_cutoff = 0.0;
   // A foot whose ZMP left the safe region holds only its orientation; its translation follows.
   bool follow_translation = false;
+  // Hz, low-pass of the feet's midpoint that the CoM reference follows; 0 = the midpoint itself.
+  double com_reference_cutoff = 0.0;
 };
 
 template <int NC>
@@ -57,6 +65,8 @@ class TaskPlanner {
     dt_ = dt;
     const double fc = p.follow_acceleration_cutoff;
     alpha_ = (fc > 0.0 && dt > 0.0) ? -std::expm1(-2.0 * kPi * fc * dt) : 0.0;
+    const double cc = p.com_reference_cutoff;
+    com_alpha_ = (cc > 0.0 && dt > 0.0) ? -std::expm1(-2.0 * kPi * cc * dt) : 0.0;
     reset();
   }
 
@@ -110,8 +120,15 @@ class TaskPlanner {
       heading += Eigen::Vector2d(R(0, 0), R(1, 0));  // horizontal projection of the foot's x axis
     }
     refs.com = p / NC;
-    refs.com.z() += com_height_;
     refs.com_velocity = v / NC;
+    if (com_alpha_ > 0.0) {
+      // First-order low-pass of the midpoint; the reference velocity is the filter's rate.
+      const Eigen::Vector3d step = com_alpha_ * (refs.com - midpoint_);
+      midpoint_ += step;
+      refs.com = midpoint_;
+      refs.com_velocity = step / dt_;
+    }
+    refs.com.z() += com_height_;
     refs.com_acceleration.setZero();
 
     // Torso: upright, at the feet's mean heading (+ the frame's offset); at rest.
@@ -152,6 +169,8 @@ class TaskPlanner {
       z += dyn.placement(c).translation().z();
     }
     com_height_ = params_.com_height > 0.0 ? params_.com_height : dyn.com().z() - z / NC;
+    midpoint_.setZero();
+    for (int c = 0; c < NC; ++c) midpoint_ += dyn.placement(c).translation() / NC;
     initialized_ = true;
   }
 
@@ -161,6 +180,8 @@ class TaskPlanner {
   double mass_ = 0.0;
   double dt_ = 0.001;
   double alpha_ = 0.0;  // low-pass gain per tick, 1 − exp(−2π f_c dt)
+  double com_alpha_ = 0.0;  // the same for the CoM reference's midpoint
+  Eigen::Vector3d midpoint_ = Eigen::Vector3d::Zero();  // low-passed midpoint of the foot references
   std::array<bool, NC> have_velocity_{};
   std::array<Vector6, NC> velocity_{}, acceleration_{};  // last measured v_F, filtered a_F
   double com_height_ = 0.0;
