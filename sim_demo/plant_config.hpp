@@ -28,8 +28,13 @@ struct ForceTorqueSite {
 };
 
 struct SensorNoise {
+  // White noise (standard deviation per sample).
   double joint_position = 0, joint_velocity = 0, imu_orientation = 0, gyro = 0, accelerometer = 0,
          force = 0, torque = 0;
+  // IMU biases, IMU frame: each axis starts at N(0, bias²) and then walks by drift·√dt·N(0, 1)
+  // per step (rad/s and rad/s/√s; m/s² and m/s²/√s).
+  double gyro_bias = 0, gyro_bias_drift = 0, accelerometer_bias = 0, accelerometer_bias_drift = 0;
+  double imu_yaw_drift = 0;  // rad/s, the orientation output turns about world z at this rate
 };
 
 struct PlantConfig {
@@ -128,6 +133,16 @@ inline PlantConfig loadPlantConfig(const std::string& path) {
     c.noise.accelerometer = number(noise["accelerometer"], "noise.accelerometer", path);
     c.noise.force = number(noise["force"], "noise.force", path);
     c.noise.torque = number(noise["torque"], "noise.torque", path);
+    // Optional: IMU biases and yaw drift (absent = none).
+    auto optional = [&](const char* key, double& v) {
+      if (noise[key]) v = number(noise[key], std::string("noise.") + key, path);
+      if (!(v >= 0)) throw std::runtime_error(path + ": 'noise." + key + "' must be >= 0");
+    };
+    optional("gyro_bias", c.noise.gyro_bias);
+    optional("gyro_bias_drift", c.noise.gyro_bias_drift);
+    optional("accelerometer_bias", c.noise.accelerometer_bias);
+    optional("accelerometer_bias_drift", c.noise.accelerometer_bias_drift);
+    optional("imu_yaw_drift", c.noise.imu_yaw_drift);
   }
   return c;
 }

@@ -126,6 +126,15 @@ void Simulation::reset() {
   for (int u = 0; u < m_->nu; ++u) d_->ctrl[u] = 0.0;
   ball_flying_ = false;  // mj_resetData parked the ball at its qpos0
   delivered_.setZero();
+  gyro_bias_.setZero();
+  accel_bias_.setZero();
+  if (options_.noise) {
+    std::normal_distribution<double> g(0.0, 1.0);
+    for (int k = 0; k < 3; ++k) {
+      gyro_bias_[k] = plant_.noise.gyro_bias * g(rng_);
+      accel_bias_[k] = plant_.noise.accelerometer_bias * g(rng_);
+    }
+  }
   mj_forward(m_, d_);
 }
 
@@ -194,9 +203,13 @@ void Simulation::readSensors(Sensors& s) {
   if (drot.norm() > 0) {
     s.imu_orientation = (s.imu_orientation * Eigen::Quaterniond(Eigen::AngleAxisd(drot.norm(), drot.normalized()))).normalized();
   }
+  if (n.imu_yaw_drift > 0) {  // the IMU's heading turns away from the world's
+    s.imu_orientation = Eigen::Quaterniond(Eigen::AngleAxisd(n.imu_yaw_drift * d_->time, Eigen::Vector3d::UnitZ())) *
+                        s.imu_orientation;
+  }
   for (int k = 0; k < 3; ++k) {
-    s.imu_gyro[k] += n.gyro * g(rng_);
-    s.imu_accel[k] += n.accelerometer * g(rng_);
+    s.imu_gyro[k] += n.gyro * g(rng_) + gyro_bias_[k];
+    s.imu_accel[k] += n.accelerometer * g(rng_) + accel_bias_[k];
   }
   for (int c = 0; c < kContacts; ++c) {
     for (int k = 0; k < 3; ++k) {
@@ -215,6 +228,14 @@ void Simulation::applyCommand(const Command& c) {
 
 void Simulation::step() {
   delivered_.setZero();
+  if (options_.noise && (plant_.noise.gyro_bias_drift > 0 || plant_.noise.accelerometer_bias_drift > 0)) {
+    std::normal_distribution<double> g(0.0, 1.0);
+    const double sq = std::sqrt(options_.control_dt);
+    for (int k = 0; k < 3; ++k) {
+      gyro_bias_[k] += plant_.noise.gyro_bias_drift * sq * g(rng_);
+      accel_bias_[k] += plant_.noise.accelerometer_bias_drift * sq * g(rng_);
+    }
+  }
   for (int k = 0; k < options_.substeps; ++k) {
     mj_step(m_, d_);
     addDeliveredTorque();

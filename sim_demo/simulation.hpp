@@ -142,6 +142,7 @@ class Simulation {
   std::array<std::array<Eigen::Vector2d, 2>, kContacts> sole_rect_;
   std::mt19937 rng_;
   VectorJ delivered_ = VectorJ::Zero();  // deliveredTorque()
+  Eigen::Vector3d gyro_bias_ = Eigen::Vector3d::Zero(), accel_bias_ = Eigen::Vector3d::Zero();  // IMU frame
 };
 
 }  // namespace hqp::sim

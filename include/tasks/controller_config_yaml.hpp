@@ -244,7 +244,7 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
     const std::string p = "estimator";
     const YAML::Node n =
         r.map(root, "", p,
-              {"method", "contact_threshold", "contact_on", "contact_full", "zero_velocity_gate", "stationary_velocity", "relative_velocity_gate", "gate_cutoff", "trust_delay",
+              {"method", "contact_threshold", "contact_on", "contact_full", "zero_velocity_gate", "stationary_velocity", "relative_velocity_gate", "gate_cutoff", "trust_delay", "motion_gate", "motion_cutoff",
                "moving_velocity", "support_acceleration_cutoff", "quaternion_tolerance", "noise"});
     EstimatorParameters& e = c.estimator;
     e.contact_threshold = r.atLeast(n, p, "contact_threshold", 0.0, true);
@@ -269,6 +269,8 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
       e.relative_velocity_gate = r.atLeast(n, p, "relative_velocity_gate", 0.0, true);
     if (n["gate_cutoff"]) e.gate_cutoff = r.atLeast(n, p, "gate_cutoff", 0.0, false);
     if (n["trust_delay"]) e.trust_delay = r.atLeast(n, p, "trust_delay", 0.0, false);
+    if (n["motion_gate"]) e.motion_gate = r.atLeast(n, p, "motion_gate", 0.0, true);
+    if (n["motion_cutoff"]) e.motion_cutoff = r.atLeast(n, p, "motion_cutoff", 0.0, false);
     if (n["moving_velocity"]) e.moving_velocity = r.atLeast(n, p, "moving_velocity", 0.0, true);
     if (n["support_acceleration_cutoff"])
       e.support_acceleration_cutoff = r.atLeast(n, p, "support_acceleration_cutoff", 0.0, false);

@@ -12,7 +12,9 @@
 //     filter whose measurements are the feet's forward kinematics and a zero velocity for each
 //     foot in contact, weighted by its contact confidence, and only if the foot's world
 //     velocity v_c predicted from the IMU passes the gate |v_c|² ≤ γ² P_vv + v_s² (a
-//     Mahalanobis test with a floor) and agrees with the stillest loaded foot. A foot on a
+//     Mahalanobis test with a floor), agrees with the stillest loaded foot, and shows no motion
+//     in its velocity from the accelerometer's integral and the kinematics alone, high-passed
+//     (a test the filter's own state cannot bias). A foot on a
 //     moving board fails it, so it does not drag the base; while no foot passes, or the feet
 //     move against each other with no clear stillest one, the IMU carries the estimate, held
 //     by a weak measurement that the loaded feet do not move on average (fallback_velocity). The same velocity gives each loaded foot's
@@ -60,6 +62,10 @@ struct EstimatorParameters {
   double relative_velocity_gate = 0.05;  // m/s
   double gate_cutoff = 20.0;           // Hz
   double trust_delay = 0.1;            // s, an untrusted foot passes the gate this long first
+  // and |high-pass(∫a dt + u_c)| ≤ motion_gate: the foot's velocity change seen by the IMU and the
+  // kinematics alone, high-passed at motion_cutoff (a still foot has none).
+  double motion_gate = 0.05;           // m/s
+  double motion_cutoff = 0.5;          // Hz
   double moving_velocity = 0.1;       // m/s, a loaded foot faster than this is flagged as moving
   double support_acceleration_cutoff = 20.0;  // Hz, low-pass of the support acceleration estimate
   // |‖q_imu‖ − 1| above this is an invalid IMU packet (update() refuses it).
@@ -106,6 +112,9 @@ class StateEstimator {
       support_velocity_[c].setZero();
       support_acceleration_[c].setZero();
       u_gate_[c].setZero();
+      motion_[c].setZero();
+      motion_hp_[c].setZero();
+      u_last_[c].setZero();
       still_time_[c] = 0.0;
       trust_[c] = 0.0;
     }
@@ -271,6 +280,9 @@ class StateEstimator {
       filter_.reset(p0 + R_wb * p_bi, v_imu, feet);
       for (int c = 0; c < NC; ++c) {
         u_gate_[c] = u[c];
+        motion_[c].setZero();
+        motion_hp_[c].setZero();
+        u_last_[c] = u[c];
         trust_[c] = contact_[c].confidence();  // standing still at start
         still_time_[c] = 0.0;
       }
@@ -290,9 +302,18 @@ class StateEstimator {
       // The tests use u_c low-passed at gate_cutoff (encoder noise would blur them).
       std::array<double, NC> speed;
       int best = -1;
+      // Independent of the filter's state (so a trusted foot cannot vouch for itself): the
+      // foot's world velocity from the accelerometer's integral and the kinematics, high-passed
+      // at motion_cutoff (then low-passed like u_c); a still foot keeps it near zero, a board
+      // that accelerates does not.
       const double ag = lowPassGain(p_.gate_cutoff, dt);
+      const double hp = 1.0 - lowPassGain(p_.motion_cutoff, dt);
+      const Eigen::Vector3d dv = dt * (quat_wi * s.imu_accel + g - filter_.bias());
       for (int c = 0; c < NC; ++c) {
         u_gate_[c] += ag * (u[c] - u_gate_[c]);
+        motion_hp_[c] = hp * (motion_hp_[c] + dv + u[c] - u_last_[c]);
+        u_last_[c] = u[c];
+        motion_[c] += ag * (motion_hp_[c] - motion_[c]);
         speed[c] = (v_pred + u_gate_[c]).norm();
         if (contact_[c].confidence() > 0.0 && (best < 0 || speed[c] < speed[best])) best = c;
       }
@@ -304,7 +325,7 @@ class StateEstimator {
       for (int c = 0; c < NC; ++c) {
         if (best < 0 || !(contact_[c].confidence() > 0.0)) continue;
         if ((u_gate_[c] - u_gate_[best]).squaredNorm() <= rel2) {
-          still[c] = speed[c] * speed[c] <= gate2;
+          still[c] = speed[c] * speed[c] <= gate2 && motion_[c].norm() <= p_.motion_gate;
         } else if (speed[c] < 2.0 * speed[best]) {
           ambiguous = true;
         }
@@ -433,6 +454,8 @@ class StateEstimator {
   std::array<double, NC> trust_{};                     // weight of each foot's zero velocity
   std::array<Eigen::Vector3d, NC> u_gate_;             // low-passed u_c for the gate (world)
   std::array<double, NC> still_time_{};                // s, time a foot has passed the gate
+  std::array<Eigen::Vector3d, NC> motion_hp_, motion_;  // high-passed IMU + kinematic foot velocity, low-passed
+  std::array<Eigen::Vector3d, NC> u_last_;             // u_c of the previous tick
   std::array<Eigen::Vector3d, NC> support_velocity_;   // world (m/s)
   std::array<Eigen::Vector3d, NC> support_acceleration_;  // world (m/s²), low-passed
   std::array<Eigen::Vector3d, NC> foot_world_;  // latched sole positions (world)
