@@ -33,6 +33,7 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -320,12 +321,18 @@ class StateEstimator {
       const double rel2 = p_.relative_velocity_gate * p_.relative_velocity_gate;
       // A foot that was not trusted must pass for trust_delay first: a board passing through
       // zero velocity at a reversal is not a still support.
-      bool ambiguous = best < 0 || speed[best] * speed[best] > gate2;
+      // Without a trusted foot the filter's velocity rests on the fallback (the feet's mean), so
+      // the absolute test would reject a still foot beside a moving one: only the motion and
+      // agreement tests decide then.
+      bool anchored = false;
+      for (int c = 0; c < NC; ++c) anchored = anchored || trust_[c] > 0.0;
+      const double gate_abs2 = anchored ? gate2 : std::numeric_limits<double>::infinity();
+      bool ambiguous = best < 0 || speed[best] * speed[best] > gate_abs2;
       std::array<bool, NC> still{};
       for (int c = 0; c < NC; ++c) {
         if (best < 0 || !(contact_[c].confidence() > 0.0)) continue;
         if ((u_gate_[c] - u_gate_[best]).squaredNorm() <= rel2) {
-          still[c] = speed[c] * speed[c] <= gate2 && motion_[c].norm() <= p_.motion_gate;
+          still[c] = speed[c] * speed[c] <= gate_abs2 && motion_[c].norm() <= p_.motion_gate;
         } else if (speed[c] < 2.0 * speed[best]) {
           ambiguous = true;
         }
