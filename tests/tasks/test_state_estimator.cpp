@@ -5,11 +5,13 @@
 #define EIGEN_RUNTIME_NO_MALLOC
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
 #include <new>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -40,7 +42,9 @@ constexpr int kFt[2] = {Robot::Frames::l_ft_sensor, Robot::Frames::r_ft_sensor};
 
 Estimator makeEstimator() {
   Estimator e({kSole[0], kSole[1]}, {kFt[0], kFt[1]}, Robot::Frames::imu);
-  e.configure(hqp::tasks::EstimatorParameters{30.0});
+  hqp::tasks::EstimatorParameters p;
+  p.contact_threshold = 30.0;
+  e.configure(p);
   return e;
 }
 
@@ -395,3 +399,107 @@ TEST(StateEstimator, RotatedImuMountIsUndone) {
 }
 
 }  // namespace
+
+namespace {
+
+Estimator makeFusedEstimator() {
+  Estimator e({kSole[0], kSole[1]}, {kFt[0], kFt[1]}, Robot::Frames::imu);
+  hqp::tasks::EstimatorParameters p;
+  p.contact_threshold = 8.0;
+  p.method = hqp::tasks::EstimatorParameters::Method::KinematicInertial;
+  e.configure(p);
+  return e;
+}
+
+}  // namespace
+
+TEST(ContactEstimator, HysteresisAndConfidenceRamp) {
+  hqp::tasks::ContactEstimator c;
+  const hqp::tasks::ContactParameters p{8.0, 9.5, 50.0};
+  // (normal force, expected contact): in above 9.5 N, out below 8 N, nothing in between flips it.
+  const std::pair<double, bool> seq[] = {{9.0, false}, {9.6, true}, {8.5, true}, {8.1, true},
+                                         {7.9, false}, {9.0, false}, {9.4, false}, {12.0, true}};
+  for (const auto& [fz, expected] : seq) {
+    c.update(fz, p);
+    EXPECT_EQ(c.inContact(), expected) << fz;
+  }
+  c.update(29.0, p);
+  EXPECT_NEAR(c.confidence(), (29.0 - 8.0) / (50.0 - 8.0), 1e-12);
+  c.update(80.0, p);
+  EXPECT_EQ(c.confidence(), 1.0);
+  c.update(std::numeric_limits<double>::quiet_NaN(), p);
+  EXPECT_FALSE(c.inContact());
+  EXPECT_EQ(c.confidence(), 0.0);
+}
+
+TEST(StateEstimator, InvalidImuQuaternionIsRefused) {
+  // A garbage IMU packet must not become "upright": a component of 6.95e261 overflows norm() to
+  // inf, and (1, 0, −6.95e261, 0) normalized by it was the identity.
+  Truth t;
+  t.q = standingState(Eigen::Vector3d::Zero());
+  t.v.setZero();
+  const Vector6 w[2] = {wrench(0, 0, 210, 0, 0, 0), wrench(0, 0, 210, 0, 0, 0)};
+  synthesise(t, w);
+  for (auto method : {hqp::tasks::EstimatorParameters::Method::Stance,
+                      hqp::tasks::EstimatorParameters::Method::KinematicInertial}) {
+    Estimator e = makeFusedEstimator();
+    auto p = e.parameters();
+    p.method = method;
+    e.configure(p);
+    ASSERT_TRUE(e.update(t.s, 0.001));
+    const VectorQ q0 = e.q();
+    Sensors s = t.s;
+    s.imu_orientation = Eigen::Quaterniond(1.0, 0.0, -6.95e261, 0.0);
+    EXPECT_FALSE(e.update(s, 0.001));
+    s.imu_orientation = Eigen::Quaterniond(2.0 * t.s.imu_orientation.coeffs());  // norm 2
+    EXPECT_FALSE(e.update(s, 0.001));
+    EXPECT_EQ(e.q(), q0);
+    s.imu_orientation = Eigen::Quaterniond(1.005 * t.s.imu_orientation.coeffs());  // within 1 %
+    EXPECT_TRUE(e.update(s, 0.001));
+  }
+}
+
+TEST(StateEstimator, KinematicInertialSeparatesAStillFootFromAMovingSupport) {
+  // The base and the left leg stand still; the right leg moves, so the right sole moves in the
+  // world as if a board carried it, while both feet stay loaded. The IMU reads gravity only.
+  // The fused estimate must keep the base at rest and give the right support's true velocity;
+  // the stance-foot estimator averages the feet and shows the phantom −v/2 (the test can fail).
+  Truth t;
+  t.q = standingState(Eigen::Vector3d::Zero());
+  const Vector6 w[2] = {wrench(0, 0, 210, 0, 0, 0), wrench(0, 0, 210, 0, 0, 0)};
+  Estimator fused = makeFusedEstimator();
+  Estimator stance = makeEstimator();
+  const double dt = 0.001, omega = 2.0 * M_PI * 1.5;
+  const int r0 = Robot::Joints::r_hip_yaw;
+  double worst_fused = 0.0, worst_support = 0.0, stance_phantom = 0.0;
+  bool moving_seen = false;
+  for (int k = 0; k < 1500; ++k) {
+    const double s = std::sin(omega * k * dt);
+    t.v.setZero();
+    Eigen::Matrix<double, 6, 1> dqr;
+    dqr << 0.0, 0.0, -1.2 * s, 2.0 * s, -0.8 * s, 0.0;  // the right sole swings along x (~0.35 m/s)
+    t.v.segment<6>(6 + r0) = dqr;
+    synthesise(t, w);
+    ASSERT_TRUE(fused.update(t.s, dt));
+    ASSERT_TRUE(stance.update(t.s, dt));
+    const Eigen::Vector3d v_right = hqp::model::frameVelocity<Robot>(t.d, kSole[1]).head<3>();
+    if (k >= 300) {  // after the gates have settled
+      const Eigen::Quaterniond qb(fused.q()[3], fused.q()[4], fused.q()[5], fused.q()[6]);
+      worst_fused = std::max(worst_fused, (qb * Eigen::Vector3d(fused.v().head<3>())).norm());
+      worst_support = std::max(worst_support, (fused.supportVelocity(1) - v_right).norm());
+      const Eigen::Quaterniond qs(stance.q()[3], stance.q()[4], stance.q()[5], stance.q()[6]);
+      stance_phantom = std::max(stance_phantom, (qs * Eigen::Vector3d(stance.v().head<3>())).norm());
+      if (v_right.norm() > 0.15) {
+        EXPECT_TRUE(fused.footMoving(1)) << k;
+        EXPECT_FALSE(fused.footMoving(0)) << k;
+        EXPECT_EQ(fused.footTrust(1), 0.0) << k;
+        moving_seen = true;
+      }
+    }
+    t.q = hqp::model::integrate<Robot>(t.q, t.v, dt);
+  }
+  EXPECT_TRUE(moving_seen);
+  EXPECT_LT(worst_fused, 0.03);     // m/s: the base stays at rest
+  EXPECT_LT(worst_support, 0.03);   // m/s: the board's velocity
+  EXPECT_GT(stance_phantom, 0.1);   // m/s: half the board's speed, in the stance estimate
+}
