@@ -105,11 +105,13 @@ class Controller {
     // 3. Task planner (Sec. III-A).
     std::array<Eigen::Vector2d, nc> cop;
     std::array<bool, nc> contact;
+    std::array<Eigen::Vector3d, nc> support_acceleration;
     for (int c = 0; c < nc; ++c) {
       cop[c] = estimator_.cop(c);
       contact[c] = estimator_.inContact(c);
+      support_acceleration[c] = estimator_.supportAcceleration(c);
     }
-    planner_.update(dyn_, cop, contact, refs_);
+    planner_.update(dyn_, cop, contact, refs_, &support_acceleration);
     stage(Stage::Planner);
 
     // 4.–5. Tasks and constraints (Table I), then the hierarchy (eqs. 3–4).

@@ -223,7 +223,7 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
     const std::string p = "planner";
     const YAML::Node n = r.map(root, "", p, {"safe_margin", "com_height", "sole", "torso_yaw_offset",
                                             "follow_acceleration_cutoff", "follow_translation",
-                                            "com_reference_cutoff"});
+                                            "com_reference_cutoff", "support_acceleration_from_estimator"});
     PlannerParameters& pl = c.planner;
     pl.safe_margin = r.atLeast(n, p, "safe_margin", 0.0, false);
     pl.com_height = r.finite(n, p, "com_height");
@@ -237,6 +237,8 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
     if (n["follow_acceleration_cutoff"])
       pl.follow_acceleration_cutoff = r.atLeast(n, p, "follow_acceleration_cutoff", 0.0, false);
     if (n["follow_translation"]) pl.follow_translation = r.boolean(n, p, "follow_translation");
+    if (n["support_acceleration_from_estimator"])
+      pl.support_acceleration_from_estimator = r.boolean(n, p, "support_acceleration_from_estimator");
     if (n["com_reference_cutoff"])
       pl.com_reference_cutoff = r.atLeast(n, p, "com_reference_cutoff", 0.0, false);
   }

@@ -53,6 +53,10 @@ struct PlannerParameters {
   bool follow_translation = false;
   // Hz, low-pass of the feet's midpoint that the CoM reference follows; 0 = the midpoint itself.
   double com_reference_cutoff = 0.0;
+  // The linear feed-forward acceleration of a following foot: false = the low-passed finite
+  // difference above; true = the state estimator's support acceleration (update()'s
+  // support_acceleration argument; the angular part stays the finite difference).
+  bool support_acceleration_from_estimator = false;
 };
 
 template <int NC>
@@ -81,10 +85,13 @@ class TaskPlanner {
     }
   }
 
-  // cop[c]: measured ZMP of foot c in its sole frame (x, y); in_contact[c]: the estimator's flag.
+  // cop[c]: measured ZMP of foot c in its sole frame (x, y); in_contact[c]: the estimator's flag;
+  // support_acceleration[c]: the estimator's world acceleration of what foot c stands on (used
+  // with support_acceleration_from_estimator; may be null otherwise).
   template <class Dyn>
   void update(const Dyn& dyn, const std::array<Eigen::Vector2d, NC>& cop,
-              const std::array<bool, NC>& in_contact, References<NC>& refs) noexcept {
+              const std::array<bool, NC>& in_contact, References<NC>& refs,
+              const std::array<Eigen::Vector3d, NC>* support_acceleration = nullptr) noexcept {
     if (!initialized_) initialize(dyn, refs);
 
     for (int c = 0; c < NC; ++c) {
@@ -93,6 +100,8 @@ class TaskPlanner {
         if (have_velocity_[c]) acceleration_[c] += alpha_ * ((v - velocity_[c]) / dt_ - acceleration_[c]);
         velocity_[c] = v;
         have_velocity_[c] = true;
+        if (params_.support_acceleration_from_estimator && support_acceleration != nullptr)
+          acceleration_[c].template head<3>() = (*support_acceleration)[c];
       }
       safe_[c] = in_contact[c] && insideSafeRegion(cop[c]);
       refs.contact_acceleration[c].setZero();
