@@ -302,7 +302,7 @@ TEST(QpContracts, RankDeficientFeasibleProblemsAreSolved) {
     }
     double stat = 0.0;
     EXPECT_LE(kktError(qp, p, &stat), 1e-9) << "seed " << seed;
-    if (seed % 10 == 0) {
+    if (seed % 25 == 0) {
       const auto ref = hqp::testing::bruteForceQp(p.A, p.b, p.E, p.e, p.C, p.lower, p.upper, 1e-7);
       ASSERT_TRUE(ref.feasible);
       EXPECT_NEAR(qp.objective(), ref.objective, 1e-7 * (1.0 + ref.objective)) << "seed " << seed;
