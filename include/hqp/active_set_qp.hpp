@@ -168,8 +168,10 @@ class ActiveSetQp {
   using VecN = Eigen::Matrix<double, NV, 1>;
 
   QpStatus solveImpl(const VectorX* x_init, bool warm_start) noexcept;
+  QpStatus solveOnce(const VectorX* x_init, bool warm_start) noexcept;  // one attempt
   void finish(QpStatus s);
-  bool prepare();                      // scaled copies, input checks
+  bool inputValid() const;             // the input contract (InvalidInput if false)
+  bool prepare();                      // scaled copies
   void startPhase(bool phase1);        // K = E rows only, objective of the phase
   bool addEqualities();                // returns false if E x = e is inconsistent
   bool addRow(int j, bool upper);      // adds C row j (side) to K; false if dependent
@@ -188,6 +190,24 @@ class ActiveSetQp {
   bool multipliers();                  // lam_ for K at x = xs_ (needs y_ from subproblem())
   QpStatus iterate(bool phase1);       // the active-set loop on the current phase
   double maxViolation(const VecN& v);  // scaled, over E and C (uses ev_, cx_)
+  // Every row of E and C holds at v: scaled violation ≤ feasibility_tol · (1 + |ĉ v|)
+  // (uses ev_, cx_); the final check before Optimal, O((me + mi) n).
+  bool feasibleAt(const VecN& v) {
+    const double tol = settings_.feasibility_tol;
+    if (me_ > 0) {
+      ev_.head(me_).noalias() = Es_.topLeftCorner(me_, n_) * v.head(n_);
+      for (int i = 0; i < me_; ++i)
+        if (!(std::abs(ev_(i) - es_(i)) <= tol * (1.0 + std::abs(ev_(i))))) return false;
+    }
+    if (mi_ > 0) {
+      cx_.head(mi_).noalias() = Cs_.topLeftCorner(mi_, n_) * v.head(n_);
+      for (int j = 0; j < mi_; ++j) {
+        const double t = tol * (1.0 + std::abs(cx_(j)));
+        if (!(ls_(j) - cx_(j) <= t) || !(cx_(j) - us_(j) <= t)) return false;
+      }
+    }
+    return true;
+  }
   void givens(int p, double c, double s);    // Q, G columns p, p+1
   // Q is kept implicit (Q = H_0 ⋯ H_{k−1}, the reflectors of the rows added since the
   // phase started) until the first working-set change of iterate(): a warm start whose
@@ -255,6 +275,7 @@ class ActiveSetQp {
   Eigen::Matrix<double, 8, NV> strip_;                     // 8 of their rows, reduced
   Eigen::Matrix<int, MI, 1> in_ws_;
   Eigen::Matrix<int, MI, 1> skip_;  // iterate(): K version at which row j was found dependent
+  Eigen::Matrix<int, MI, 1> pin_;   // iterate(): row kept in K, never dropped (see there)
   Eigen::Matrix<double, NV, 1> rhs_;
   MatNN Q_, R_;
   bool qexplicit_ = false;  // Q_ is valid; otherwise Q is the product of Hv_, htau_
@@ -727,14 +748,25 @@ void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addRowsImplicit(int cnt, Row ro
 }
 
 template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::inputValid() const {
+  // The input contract (docs/hqp.md, "Contracts"): finite data of magnitude ≤ max_magnitude,
+  // bounds ±inf only on their own side. One vectorized pass per block.
+  if (n_ <= 0) return true;
+  const double mx = settings_.max_magnitude;
+  if (!detail::withinMagnitude(A_, mx) || !detail::withinMagnitude(b_, mx)) return false;
+  if (!detail::withinMagnitude(E_, mx) || !detail::withinMagnitude(e_, mx)) return false;
+  if (!detail::withinMagnitude(C_, mx)) return false;
+  for (int j = 0; j < mi_; ++j)
+    if (!detail::boundsValid(lower_(j), upper_(j), mx)) return false;
+  return true;
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
 bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::prepare() {
-  // Rows scaled to unit norm (zero rows stay zero); non-finite data is rejected
-  // (±inf bounds are allowed, NaN bounds are not).
+  // Rows scaled to unit norm (zero rows stay zero); the input passed inputValid().
   if (n_ <= 0) return true;
   // A row norm is finite iff the row is.
-  if (!b_.allFinite() || !e_.allFinite()) return false;
   if (mi_ > 0) {
-    if (lower_.hasNaN() || upper_.hasNaN()) return false;
     cinv_.head(mi_) = C_.rowwise().norm();
     if (!cinv_.head(mi_).allFinite()) return false;
     for (int j = 0; j < mi_; ++j) cinv_(j) = cinv_(j) > 0.0 ? 1.0 / cinv_(j) : 1.0;
@@ -915,6 +947,13 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
   // ~1 in 1500 random degenerate hierarchies, tests/hqp/test_hqp_inequality.cpp).
   int kver = 0;
   if (mi_ > 0) skip_.head(mi_).setConstant(-1);
+  // A row dropped for a negative multiplier moves off its bound in exact arithmetic; if it
+  // blocks the very next step at once (zero length), the multiplier's sign is rounding noise
+  // (a nearly singular A Z turns it into a huge, meaningless step). The row is re-added and
+  // kept ("pinned", its multiplier taken as 0) for the rest of the phase: otherwise the
+  // drop / re-add pair repeats until the iteration cap (rank-deficient or badly scaled A).
+  int just_dropped = -1;
+  if (mi_ > 0) pin_.head(mi_).setZero();
   // Ĉ x; skipped when the caller's feasibility check just computed it at this xc_.
   if (mi_ > 0 && !cx_at_xc_) cx_.head(mi_).noalias() = Cs_.topLeftCorner(mi_, n_) * xc_.head(n_);
   cx_at_xc_ = false;
@@ -981,6 +1020,8 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
       ensureExplicit();
       // A row numerically dependent on K cannot be held; skip it until K changes.
       if (!trap_ && ++changes_ >= kEstablishAfter) establishStructure();
+      if (!phase1 && block == just_dropped && alpha * dn <= 1e-14 * (1.0 + xn)) pin_(block) = 1;
+      just_dropped = -1;
       if (addRow(block, block_upper)) ++kver;
       else skip_(block) = kver;
       continue;
@@ -998,7 +1039,7 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
     const bool bland = zero_steps > 2;
     for (int w = 0; w < nw_; ++w) {
       const int j = ws_row_(w);
-      if (ls_(j) == us_(j)) continue;
+      if (ls_(j) == us_(j) || pin_(j)) continue;
       const double mu = ws_upper_(w) ? lam_(neq_ + w) : -lam_(neq_ + w);
       if (bland) {
         if (mu < thr && (drop < 0 || j < ws_row_(drop))) drop = w;
@@ -1012,6 +1053,7 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
     ++iterations_;
     ensureExplicit();
     if (!trap_ && ++changes_ >= kEstablishAfter) establishStructure();
+    just_dropped = ws_row_(drop);
     removeRow(neq_ + drop);
     ++kver;
   }
@@ -1031,6 +1073,22 @@ void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::finish(QpStatus s) {
 template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
 QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::solveImpl(const VectorX* x_init,
                                                                bool warm_start) noexcept {
+  const bool warm = warm_start && have_ws_;
+  solveOnce(x_init, warm_start);
+  // A warm start that runs into the iteration cap (a previous working set that leads the
+  // method astray, e.g. through a long degenerate stretch) falls back to one cold solve with
+  // its own budget: the worst case is 2 · max_iterations.
+  if (warm && status_ == QpStatus::IterationLimit) {
+    const int spent = iterations_;
+    solveOnce(x_init, false);
+    iterations_ += spent;
+  }
+  return status_;
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::solveOnce(const VectorX* x_init,
+                                                               bool warm_start) noexcept {
   iterations_ = 0;
   xs_fresh_ = false;
   cx_at_xc_ = false;
@@ -1038,6 +1096,13 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::solveImpl(const VectorX* x_
   const bool warm = warm_start && have_ws_;
   cold_ = !warm;
   const int nw_prev = nw_;
+  if (!inputValid()) {
+    x_.setZero(n_);
+    nw_ = 0;
+    have_ws_ = false;
+    finish(QpStatus::InvalidInput);
+    return status_;
+  }
   if (!prepare()) {
     x_.setZero(n_);
     nw_ = 0;
@@ -1114,7 +1179,9 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::solveImpl(const VectorX* x_
       addEqualities();
     }
   }
-  const QpStatus s2 = iterate(false);
+  QpStatus s2 = iterate(false);
+  // No Optimal without a feasible x: every row re-checked at the returned point.
+  if (s2 == QpStatus::Optimal && !feasibleAt(xc_)) s2 = QpStatus::NumericalFailure;
   if (s2 == QpStatus::NumericalFailure && !xc_.head(n_).allFinite()) {
     x_.setZero(n_);
   } else {
@@ -1126,6 +1193,7 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::solveImpl(const VectorX* x_
     for (int w = 0; w < nw_; ++w) {
       const int j = ws_row_(w);
       double mu = (ws_upper_(w) ? lam_(neq_ + w) : -lam_(neq_ + w)) * cinv_(j);
+      if (pin_(j) && ls_(j) != us_(j) && mu < 0.0) mu = 0.0;  // pinned: sign is noise
       if (ls_(j) == us_(j) && mu < 0.0) {  // equality row: report the side by sign
         ws_upper_(w) = ws_upper_(w) ? 0 : 1;
         mu = -mu;

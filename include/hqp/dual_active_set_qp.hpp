@@ -30,15 +30,26 @@ class DualActiveSetQp {
  public:
   using VectorX = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, MaxN, 1>;
 
+  // Relative floor of factorize()'s min_sigma: σ_min(A) must exceed kMinSigmaFloor · ‖A‖_F
+  // whatever the caller asks. Below it (cond(A) ≳ 1e9) the method's rounding errors grow
+  // with cond(A)² and it can report Infeasible for a feasible problem or return a point
+  // that violates a row; the final check of solve() catches the latter, this the former.
+  static constexpr double kMinSigmaFloor = 1e-9;
+
   // Factorizes A (rows r ≥ n, n columns) and forms the unconstrained minimizer R⁻¹ (Q_Aᵀ b).
-  // Returns false, and nothing is valid, unless 1/‖R⁻¹‖_F > min_sigma, a lower bound of
+  // Returns false, and nothing is valid (solve() then returns InvalidInput), unless A and b
+  // are finite and 1/‖R⁻¹‖_F > max(min_sigma, kMinSigmaFloor · ‖A‖_F), a lower bound of
   // σ_min(A): the objective is then strictly convex by at least that margin.
   template <class MatA, class VecB>
   bool factorize(const MatA& A, const VecB& b, int r, int n, double min_sigma) noexcept {
     n_ = n;
+    factorized_ = false;
     if (n <= 0 || n > MaxN || r < n || r > MaxRows) return false;
     F_.topLeftCorner(r, n) = A.topLeftCorner(r, n);
     c_.head(r) = b.head(r);
+    const double anorm = F_.topLeftCorner(r, n).norm();
+    if (!std::isfinite(anorm) || !c_.head(r).allFinite()) return false;
+    min_sigma = std::max(min_sigma, kMinSigmaFloor * anorm);
     // Householder QR, column by column on raw columns (at ≤ 15 x 9, Eigen's block
     // expressions cost more than the flops): H_i = I − τ [1; v][1; v]ᵀ, v below the diagonal.
     for (int i = 0; i < n; ++i) {
@@ -80,13 +91,18 @@ class DualActiveSetQp {
     const double jn2 = J_.topLeftCorner(n, n).squaredNorm();
     if (!(jn2 < kInf) || !(jn2 * min_sigma * min_sigma < 1.0)) return false;
     x0_.noalias() = J_.topLeftCorner(n, n) * c_.head(n);  // R⁻¹ (Q_Aᵀ b)(0:n)
-    return x0_.allFinite();
+    factorized_ = x0_.allFinite();
+    return factorized_;
   }
 
   // Solves with the constraint rows C (m × n, n of factorize()) and their bounds (±inf for an
-  // absent side). Status: Optimal; Infeasible (a violated row is dependent on the active rows
-  // with no multiplier that can give way); IterationLimit; NumericalFailure. x() is only the
-  // solution when Optimal. Warm start: the rows prefer[0..count) (e.g. the previous active set)
+  // absent side). Status: Optimal (checked: every row holds to feasibility_tol · (1 + |ĉ x|)
+  // scaled to a unit row, and the stationarity residual is at rounding level); Infeasible (a
+  // row with lower > upper, or a violated row dependent on the active rows with no
+  // multiplier that can give way); IterationLimit; NumericalFailure (non-finite numbers, or
+  // the final check failed); InvalidInput (no successful factorize(), NaN / ±inf in C, a
+  // bound of +inf as lower or −inf as upper, a magnitude above max_magnitude). x() is only
+  // the solution when Optimal. Warm start: the rows prefer[0..count) (e.g. the previous active set)
   // are added first while one of them is violated; any order of violated rows is valid for the
   // method, this one avoids adding rows that are dropped again.
   template <class MatC, class VecL, class VecU>
@@ -96,13 +112,27 @@ class DualActiveSetQp {
     const int n = n_;
     q_ = 0;
     iterations_ = 0;
+    if (!factorized_ || m < 0 || m > MaxIneq) {
+      x_.setZero(n > 0 ? n : 0);
+      return QpStatus::InvalidInput;
+    }
     x_ = x0_;
-    if (m > MaxIneq) return QpStatus::NumericalFailure;
+    // Input contract, then empty intervals (scaled like the violations below).
+    if (!detail::withinMagnitude(C.topLeftCorner(m, n), settings.max_magnitude)) {
+      x_.setZero(n);
+      return QpStatus::InvalidInput;
+    }
+    for (int j = 0; j < m; ++j)
+      if (!detail::boundsValid(lower(j), upper(j), settings.max_magnitude)) {
+        x_.setZero(n);
+        return QpStatus::InvalidInput;
+      }
     for (int j = 0; j < m; ++j) {
-      const double nrm = C.row(j).norm();
+      const double nrm = C.row(j).head(n).norm();
       rinv_(j) = nrm > 0.0 ? 1.0 / nrm : 1.0;
       active_(j) = 0;
       prefer_(j) = 0;
+      if ((lower(j) - upper(j)) * rinv_(j) > settings.feasibility_tol) return QpStatus::Infeasible;
     }
     for (int k = 0; k < prefer_count; ++k)
       if (prefer[k] >= 0 && prefer[k] < m) prefer_(prefer[k]) = 1;
@@ -120,7 +150,7 @@ class DualActiveSetQp {
           if (vu > worst) worst = vu, p = j, up = true;
         }
       }
-      if (p < 0) return x_.allFinite() ? QpStatus::Optimal : QpStatus::NumericalFailure;
+      if (p < 0) return verified(C, lower, upper, m, settings);
       const double sgn = up ? -1.0 : 1.0;  // normal n_p = sgn · C_p, n_pᵀ x ≥ sgn · bound
       np_.head(n) = sgn * C.row(p).head(n).transpose();
       double s = sgn * cx_(p) - (up ? -upper(p) : lower(p));  // < 0: violated
@@ -180,6 +210,8 @@ class DualActiveSetQp {
 
   const VectorX& x() const { return x_; }
   const VectorX& unconstrainedMinimizer() const { return x0_; }
+  // Tolerance of the stationarity check before Optimal (relative to the terms' magnitude).
+  static constexpr double kStationarityTol = 1e-8;
   int iterations() const { return iterations_; }
   int numActive() const { return q_; }
   int activeRow(int k) const { return row_(k); }
@@ -242,6 +274,42 @@ class DualActiveSetQp {
     }
   }
 
+  // The final check before Optimal, O(m n + n² + q n): x finite, every row (both sides, active
+  // rows included) within feasibility_tol · (1 + |ĉ x|), and the stationarity residual
+  // RᵀR x − Rᵀ(Q_Aᵀ b) + Σ ±u_k c_k = Aᵀ(A x − b) + Σ ±u_k c_k at rounding level relative to
+  // its terms. Rounding with a nearly singular A shows up here rather than as a wrong Optimal.
+  template <class MatC, class VecL, class VecU>
+  QpStatus verified(const MatC& C, const VecL& lower, const VecU& upper, int m,
+                    const QpSettings& settings) {
+    const int n = n_;
+    if (!x_.allFinite()) return QpStatus::NumericalFailure;
+    cx_.head(m).noalias() = C.topLeftCorner(m, n) * x_;
+    for (int j = 0; j < m; ++j) {
+      const double v = cx_(j) * rinv_(j);
+      const double t = settings.feasibility_tol * (1.0 + std::abs(v));
+      if (!((lower(j) * rinv_(j) - v) <= t) || !((v - upper(j) * rinv_(j)) <= t))
+        return QpStatus::NumericalFailure;
+    }
+    // g = Rᵀ(R x − c), R upper triangular in F_.
+    const auto R = F_.topLeftCorner(n, n).template triangularView<Eigen::Upper>();
+    z_.head(n).noalias() = R * x_;
+    double scale = z_.head(n).cwiseAbs().maxCoeff() + c_.head(n).cwiseAbs().maxCoeff();
+    z_.head(n) -= c_.head(n);
+    r_.head(n).noalias() = R.transpose() * z_.head(n);
+    double rn = 0.0;  // ‖R‖₁
+    for (int j = 0; j < n; ++j) rn = std::max(rn, F_.col(j).head(j + 1).cwiseAbs().sum());
+    scale *= rn;
+    for (int k = 0; k < q_; ++k) {
+      const double mu = upper_(k) ? u_(k) : -u_(k);
+      r_.head(n) += mu * C.row(row_(k)).head(n).transpose();
+      scale += std::abs(u_(k)) * C.row(row_(k)).head(n).cwiseAbs().maxCoeff();
+    }
+    if (!(r_.head(n).cwiseAbs().maxCoeff() <= kStationarityTol * scale))
+      return QpStatus::NumericalFailure;
+    return QpStatus::Optimal;
+  }
+
+  bool factorized_ = false;
   int n_ = 0, q_ = 0, iterations_ = 0;
   Eigen::Matrix<double, MaxRows, MaxN> F_;   // QR of A (R on and above the diagonal)
   Eigen::Matrix<double, MaxRows, 1> c_;  // Q_Aᵀ b

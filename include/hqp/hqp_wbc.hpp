@@ -40,6 +40,12 @@ struct HqpSettings {
   // A last level whose Â_p has full column rank is a strictly convex QP: solve it with the
   // dual method (DualActiveSetQp) from its unconstrained minimizer instead of ActiveSetQp.
   bool dual_last_level = true;
+  // Numerical health: after all levels are solved, level p's weighted residual ‖W^½(A_p x − b_p)‖
+  // at the final x may exceed its value at x*_p by at most
+  //   residual_rise_tol · (‖W^½ A_p‖_F · max(‖x*_p‖, 1) + ‖W^½ b_p‖);
+  // a larger rise (lower levels' data so large that their rounding swamps a higher level) is
+  // reported as HqpLevelResult::degraded and HqpResult::higher_level_degraded.
+  double residual_rise_tol = 1e-6;
 };
 
 // What happened at one level; MaxActive = capacity of the stacked constraint rows.
@@ -60,6 +66,9 @@ struct HqpLevelResult {
   double violation = 0.0;            // Σ over own rows of squared bound violation at x*
   double time_us = 0.0;              // wall time of this level's solve (steady_clock), µs
   bool dual = false;                 // solved by DualActiveSetQp (HqpSettings::dual_last_level)
+  // The level's residual at the final x rose beyond HqpSettings::residual_rise_tol above its
+  // value at x*_p: the lower levels degraded it (numerical health, docs/hqp.md).
+  bool degraded = false;
 };
 
 template <int Nx, int NumLevels, int MaxActive>
@@ -67,6 +76,9 @@ struct HqpResult {
   Eigen::Matrix<double, Nx, 1> x = Eigen::Matrix<double, Nx, 1>::Zero();  // x*
   QpStatus status = QpStatus::Optimal;  // first non-optimal level's status, else Optimal
   int failed_level = -1;                // 0-based index of that level, −1 if none
+  // Some level's residual was degraded by the lower levels (HqpLevelResult::degraded): x is
+  // finite but does not keep the priorities to tolerance. Treat as a solver failure.
+  bool higher_level_degraded = false;
   std::array<HqpLevelResult<MaxActive>, NumLevels> levels{};
 };
 
@@ -198,16 +210,35 @@ class HqpWbc {
       dx_.setZero();
     }
     bt_ = b_;
+    result_.higher_level_degraded = false;
     if (!inputValid()) {
       for (auto& lr : result_.levels) lr = HqpLevelResult<max_active>{};
-      result_.status = QpStatus::NumericalFailure;
+      result_.status = QpStatus::InvalidInput;
       result_.failed_level = 0;
-      result_.levels[0].status = QpStatus::NumericalFailure;
+      result_.levels[0].status = QpStatus::InvalidInput;
       result_.x = x_;
       return result_.status;
     }
     solveLevels(std::make_index_sequence<sizeof...(Levels)>{});
-    reconstructX();
+    reconstructX(num_levels);
+    // Never a non-finite x: fall back to the last finite x*_p of the higher levels (or 0),
+    // with a non-optimal status at the first level left out.
+    if (!x_.allFinite()) {
+      int p = num_levels - 1;
+      for (; p > 0; --p) {
+        reconstructX(p);
+        if (x_.allFinite()) break;
+      }
+      if (p == 0) x_.setZero();
+      if (result_.failed_level < 0 || result_.failed_level > p) {
+        result_.failed_level = p;
+        result_.status = QpStatus::NumericalFailure;
+      }
+      if (result_.levels[static_cast<std::size_t>(p)].status == QpStatus::Optimal)
+        result_.levels[static_cast<std::size_t>(p)].status = QpStatus::NumericalFailure;
+    } else {
+      checkHealth();
+    }
     result_.x = x_;
     return result_.status;
   }
@@ -285,19 +316,45 @@ class HqpWbc {
      ...);
   }
 
-  // Rejects NaN anywhere and infinite matrix entries (bounds may be ±inf); never NaN out.
-  // 0 · v is NaN for ±inf and NaN entries: one vectorized sum per matrix instead of
-  // allFinite()'s element-by-element test.
-  template <class M>
-  static bool finite(const M& m) {
-    return (m.array() * 0.0).sum() == 0.0;
-  }
+  // The input contract (docs/hqp.md, "Contracts"): finite A, b, w, D with magnitudes
+  // ≤ QpSettings::max_magnitude (NaN and ±inf fail the vectorized |v| ≤ max test), w ≥ 0,
+  // bounds NaN-free and ±inf only on their own side. Never NaN out.
   bool inputValid() const {
-    if (!finite(A_) || !finite(b_) || !finite(w_) || !finite(D_)) return false;
+    const double mx = settings_.qp.max_magnitude;
+    if (!detail::withinMagnitude(A_, mx) || !detail::withinMagnitude(b_, mx) ||
+        !detail::withinMagnitude(w_, mx) || !detail::withinMagnitude(D_, mx))
+      return false;
     if (w_.minCoeff() < 0.0) return false;
     for (int r = 0; r < total_constraint_rows; ++r)
-      if (std::isnan(lower_(r)) || std::isnan(upper_(r))) return false;
+      if (!detail::boundsValid(lower_(r), upper_(r), mx)) return false;
     return true;
+  }
+
+  // Numerical health (HqpSettings::residual_rise_tol): every level's weighted residual at the
+  // final x against its value at x*_p. ‖x*_p‖ ≤ Σ_{q ≤ p} ‖u'_q‖ (orthonormal bases).
+  // O(total task rows · Nx) per solve.
+  void checkHealth() {
+    double xs = 0.0;  // bound of ‖x*_p‖
+    for (int p = 0; p < num_levels; ++p) {
+      const std::size_t ps = static_cast<std::size_t>(p);
+      auto& lr = result_.levels[ps];
+      if (var_[ps] > 0) xs += up_[ps].norm();
+      const int t0 = task_offset[ps], r = task_offset[ps + 1] - t0;
+      double an2 = 0.0, bn2 = 0.0, e2 = 0.0;
+      for (int i = t0; i < t0 + r; ++i) {
+        const double w = w_(i);
+        const double e = A_.row(i).dot(x_) - b_(i);
+        an2 += w * A_.row(i).squaredNorm();
+        bn2 += w * b_(i) * b_(i);
+        e2 += w * e * e;
+      }
+      const double tol = settings_.residual_rise_tol *
+                         (std::sqrt(an2) * std::max(xs, 1.0) + std::sqrt(bn2));
+      if (!(std::sqrt(e2) <= std::sqrt(lr.objective) + tol)) {
+        lr.degraded = true;
+        result_.higher_level_degraded = true;
+      }
+    }
   }
 
   template <std::size_t... I>
@@ -327,9 +384,10 @@ class HqpWbc {
   // x* = Σ_p Z_{p−1} Q_p u'_p with Z_p = Z_{p−1} Q_p E_p, E_p = [0; I] (the null-space
   // columns): x* = Q_0 (u'_0 + E_0 Q_1 (u'_1 + E_1 Q_2 (…))), evaluated from the last level up
   // with each level's stored reflectors (vector work only; no Z is ever formed).
-  void reconstructX() {
+  // Levels [0, levels) only: x*_{levels−1} (the fallback of solve()).
+  void reconstructX(int levels) {
     v_.resize(0);
-    for (int p = num_levels - 1; p >= 0; --p) {
+    for (int p = levels - 1; p >= 0; --p) {
       const std::size_t ps = static_cast<std::size_t>(p);
       const int n = var_[ps];
       if (n == 0) continue;
@@ -525,6 +583,9 @@ class HqpWbc {
     cnorm_.head(c) = Cw.rowwise().squaredNorm();
     for (int i = 0; i < c; ++i) {
       double lo = lower_(i) - dx_(i), up = upper_(i) - dx_(i);
+      // An own row with an empty interval: infeasible, the general path applies the policy.
+      if (i >= c0 && (lower_(i) - upper_(i)) / rowScale(Dnorm_(i)) > settings_.qp.feasibility_tol)
+        return false;
       widenHigherRow(i, c0, lo, up);
       if (lockedRow(i, cnorm_(i))) {
         if (i >= c0 && !lockedRowHolds(i, lo, up)) return false;

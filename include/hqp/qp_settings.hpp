@@ -1,5 +1,8 @@
 #pragma once
-// Tolerances and limits of ActiveSetQp (include/hqp/active_set_qp.hpp).
+// Tolerances and limits of ActiveSetQp and DualActiveSetQp (include/hqp/active_set_qp.hpp,
+// include/hqp/dual_active_set_qp.hpp); HqpWbc and WqpWbc pass them to every QP.
+
+#include <cmath>
 
 namespace hqp {
 
@@ -8,6 +11,29 @@ struct QpSettings {
   double feasibility_tol = 1e-9;  // accepted violation of a constraint row scaled to unit norm
   double rank_tol = 1e-12;        // relative rank threshold of the QR / COD factorizations
   double dual_tol = 1e-10;        // multiplier sign threshold (relative to the gradient scale)
+  // Input contract: every matrix and right-hand-side entry and every finite bound must have
+  // |v| ≤ max_magnitude (squares and products of such numbers stay far from overflow).
+  // Larger data, NaN or ±inf data is refused with QpStatus::InvalidInput. Scale the problem
+  // (units) rather than raising this.
+  double max_magnitude = 1e50;
 };
+
+namespace detail {
+
+// True if every entry v of m is finite with |v| ≤ max (NaN compares false).
+template <class M>
+bool withinMagnitude(const M& m, double max) {
+  return (m.array().abs() <= max).all();
+}
+
+// A bound pair is in the contract if neither is NaN, lower ≠ +inf, upper ≠ −inf and each
+// finite side has magnitude ≤ max. (lower > upper is allowed: the row is then infeasible.)
+inline bool boundsValid(double lower, double upper, double max) {
+  const bool lo_ok = lower == -HUGE_VAL || std::abs(lower) <= max;
+  const bool up_ok = upper == HUGE_VAL || std::abs(upper) <= max;
+  return lo_ok && up_ok;
+}
+
+}  // namespace detail
 
 }  // namespace hqp

@@ -1,13 +1,17 @@
 #pragma once
-// Exit status of ActiveSetQp::solve() (include/hqp/active_set_qp.hpp).
+// Exit status of the QP solvers (ActiveSetQp, DualActiveSetQp) and of the hierarchies
+// (HqpWbc, WqpWbc). Input contracts and what each status means: docs/hqp.md, "Contracts".
 
 namespace hqp {
 
 enum class QpStatus : int {
-  Optimal = 0,       // KKT conditions hold to the tolerances of QpSettings
+  Optimal = 0,       // KKT conditions hold to the tolerances of QpSettings; x() meets every row
   Infeasible,        // E x = e inconsistent, or no x meets the inequalities (phase 1 optimum t > tol)
   IterationLimit,    // QpSettings::max_iterations working-set changes; x() is the last feasible iterate
-  NumericalFailure,  // a non-finite number appeared; x() is the last feasible iterate (or 0)
+  NumericalFailure,  // a non-finite number appeared, or the result failed its final check
+                     // (feasibility / stationarity); x() is finite but not a solution
+  InvalidInput,      // the input breaks the contract (NaN, ±inf data, a bound of +inf as lower or
+                     // −inf as upper, a magnitude above QpSettings::max_magnitude); x() is 0
 };
 
 inline const char* toString(QpStatus s) {
@@ -16,6 +20,7 @@ inline const char* toString(QpStatus s) {
     case QpStatus::Infeasible: return "Infeasible";
     case QpStatus::IterationLimit: return "IterationLimit";
     case QpStatus::NumericalFailure: return "NumericalFailure";
+    case QpStatus::InvalidInput: return "InvalidInput";
   }
   return "Unknown";
 }

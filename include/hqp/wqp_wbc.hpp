@@ -94,14 +94,18 @@ class WqpWbc {
   // One QP with all tasks (weighted) and all constraints; no heap, no exceptions.
   QpStatus solve() noexcept {
     stackAll(std::make_index_sequence<sizeof...(Levels)>{});
-    bool valid = A_.allFinite() && b_.allFinite() && w_.allFinite() && D_.allFinite() &&
+    // The input contract (docs/hqp.md, "Contracts"), as HqpWbc: finite data with magnitudes
+    // ≤ max_magnitude, w ≥ 0, bounds ±inf only on their own side, finite level weights ≥ 0.
+    const double mx = qp_.settings().max_magnitude;
+    bool valid = detail::withinMagnitude(A_, mx) && detail::withinMagnitude(b_, mx) &&
+                 detail::withinMagnitude(w_, mx) && detail::withinMagnitude(D_, mx) &&
                  (w_.array() >= 0.0).all();
     for (int r = 0; r < total_constraint_rows; ++r)
-      valid = valid && !std::isnan(lower_(r)) && !std::isnan(upper_(r));
-    for (double l : level_weight_) valid = valid && std::isfinite(l) && l >= 0.0;
+      valid = valid && detail::boundsValid(lower_(r), upper_(r), mx);
+    for (double l : level_weight_) valid = valid && std::isfinite(l) && l >= 0.0 && l <= mx;
     if (!valid) {
       result_ = Result{};
-      result_.status = QpStatus::NumericalFailure;
+      result_.status = QpStatus::InvalidInput;
       return result_.status;
     }
     qp_.resize(Nx, total_task_rows, 0, total_constraint_rows);

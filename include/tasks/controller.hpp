@@ -186,20 +186,24 @@ class Controller {
   }
 
   // Level 1 (the dynamics) must be optimal; lower levels may stop at their iteration cap
-  // (their iterate is feasible and higher levels are kept); a numerical failure anywhere or a
+  // (their iterate is feasible and higher levels are kept); a numerical failure or invalid
+  // input anywhere, a higher level degraded by the lower ones (numerical health) or a
   // non-finite x is a failure.
   bool solutionUsable(const VectorX& x) const {
     if (!x.allFinite()) return false;
     if (diag_.levels[0].status != QpStatus::Optimal) return false;
+    if (diag_.higher_level_degraded) return false;
     for (const auto& l : diag_.levels)
-      if (l.status == QpStatus::NumericalFailure) return false;
+      if (l.status == QpStatus::NumericalFailure || l.status == QpStatus::InvalidInput) return false;
     return true;
   }
 
   void recordSolver(QpStatus status) {
     diag_.status = status;
+    diag_.higher_level_degraded = false;
     if (config_.solver == Config::Solver::Hqp) {
       const auto& r = hqp_.result();
+      diag_.higher_level_degraded = r.higher_level_degraded;
       for (int p = 0; p < num_levels; ++p) {
         const auto& src = r.levels[p];
         auto& dst = diag_.levels[p];

@@ -18,7 +18,8 @@ enum class ControllerMode : int {
 enum class SafeModeReason : int {
   None = 0,
   NonFiniteSensor,  // a NaN/inf in the sensor data
-  SolverFailure,    // level 1 not optimal, a numerical failure, or a non-finite solution
+  SolverFailure,    // level 1 not optimal, a numerical failure or invalid input, a higher level
+                    // degraded by lower ones (numerical health), or a non-finite solution
   Fallen,           // torso tilt or torso height beyond SafeModeParameters
   NonFiniteOutput,  // the joint-level command was not finite (never sent)
 };
@@ -63,6 +64,9 @@ struct ControllerDiagnostics {
   SafeModeReason reason = SafeModeReason::None;
   long ticks = 0;                  // ticks since construction or reset()
   QpStatus status = QpStatus::Optimal;  // the solver's overall status this tick
+  // HqpWbc's numerical health: some level's residual was raised beyond tolerance by the lower
+  // levels (HqpResult::higher_level_degraded); the tick counts as a solver failure.
+  bool higher_level_degraded = false;
   std::array<LevelDiagnostics<MaxActive>, NumLevels> levels{};
   std::array<bool, NumContacts> in_contact{};       // estimator: F/T normal force above threshold
   std::array<bool, NumContacts> following{};        // planner: ZMP in the safe region (Sec. III-A)

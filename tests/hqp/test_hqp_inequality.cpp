@@ -306,12 +306,12 @@ TEST(HqpInequality, NanInputNeverGivesNan) {
   auto L = makeLevels(0, g);
   L[2].A(0, 0) = std::numeric_limits<double>::quiet_NaN();
   fill(wbc, L);
-  EXPECT_EQ(wbc.solve(), hqp::QpStatus::NumericalFailure);
+  EXPECT_EQ(wbc.solve(), hqp::QpStatus::InvalidInput);
   EXPECT_TRUE(wbc.x().allFinite());
   L = makeLevels(0, g);
   L[1].lower(0) = std::numeric_limits<double>::quiet_NaN();
   fill(wbc, L);
-  EXPECT_EQ(wbc.solve(), hqp::QpStatus::NumericalFailure);
+  EXPECT_EQ(wbc.solve(), hqp::QpStatus::InvalidInput);
   EXPECT_TRUE(wbc.x().allFinite());
 }
 

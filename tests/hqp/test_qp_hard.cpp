@@ -287,19 +287,19 @@ TEST(QpHard, IterationCapReturnsFeasibleIterate) {
   for (int i = 0; i < 8; ++i) EXPECT_NEAR(qp.x()(i), 2.0, 1e-12);
 }
 
-TEST(QpHard, NonFiniteInputIsNumericalFailure) {
+TEST(QpHard, NonFiniteInputIsInvalidInput) {
   Qp qp;
   qp.resize(2, 2, 0, 0);
   qp.A().setIdentity();
   qp.b() << 1, std::numeric_limits<double>::quiet_NaN();
   const auto s = qp.solve(false);
-  EXPECT_EQ(str(s), "NumericalFailure");
+  EXPECT_EQ(str(s), "InvalidInput");
   EXPECT_TRUE(qp.x().allFinite());
   // NaN in A, in a constraint row, in a bound: rejected as well.
   const double nan = std::numeric_limits<double>::quiet_NaN();
   qp.b() << 1, 1;
   qp.A()(1, 0) = nan;
-  EXPECT_EQ(str(qp.solve(false)), "NumericalFailure");
+  EXPECT_EQ(str(qp.solve(false)), "InvalidInput");
   qp.A().setIdentity();
   EXPECT_EQ(str(qp.solve(false)), "Optimal");
   qp.resize(2, 2, 0, 1);
@@ -308,11 +308,11 @@ TEST(QpHard, NonFiniteInputIsNumericalFailure) {
   qp.C() << 1, nan;
   qp.lower() << 0;
   qp.upper() << 1;
-  EXPECT_EQ(str(qp.solve(false)), "NumericalFailure");
+  EXPECT_EQ(str(qp.solve(false)), "InvalidInput");
   EXPECT_TRUE(qp.x().allFinite());
   qp.C() << 1, 0;
   qp.upper() << nan;
-  EXPECT_EQ(str(qp.solve(false)), "NumericalFailure");
+  EXPECT_EQ(str(qp.solve(false)), "InvalidInput");
 }
 
 TEST(QpHard, HessianForm) {
