@@ -162,8 +162,11 @@ inline void setInertia(const RawRobot& r, const Group& g, Body& b) {
 
 inline void setJoint(const RawJoint& raw, Body& b) {
   const Eigen::Vector3d axis(raw.axis[0], raw.axis[1], raw.axis[2]);
-  if (!axis.allFinite() || axis.norm() < 1e-12) throw jointError(raw.name, "zero axis");
-  b.axis = axis.normalized();
+  // The scan rejects axes whose squared norm overflows; an inf norm would normalize to (0, 0, 0).
+  const double norm = axis.norm();
+  if (!axis.allFinite() || !std::isfinite(norm)) throw jointError(raw.name, "the axis is not a finite direction");
+  if (norm < 1e-12) throw jointError(raw.name, "zero axis");
+  b.axis = axis / norm;
   b.lower = -kInf;
   b.upper = kInf;
   b.velocity = kInf;

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <locale>
 #include <map>
 #include <sstream>
@@ -142,6 +143,8 @@ inline RawRobot scanUrdf(const std::string& xml) {
       const TiXmlElement* mass = in->FirstChildElement("mass");
       if (mass == nullptr) throw fail("<inertial> has no <mass>");
       detail::readNumber(mass, "value", l.mass, true, fail);
+      // Checked here for every link, also those fused into a fixed base (whose inertia is dropped).
+      if (!std::isfinite(l.mass) || l.mass < 0) throw fail("negative or invalid mass " + show(l.mass));
       const TiXmlElement* I = in->FirstChildElement("inertia");
       if (I == nullptr) throw fail("<inertial> has no <inertia>");
       detail::readNumber(I, "ixx", l.ixx, true, fail);
@@ -190,6 +193,11 @@ inline RawRobot scanUrdf(const std::string& xml) {
     if (const TiXmlElement* a = e->FirstChildElement("axis")) {
       if (const char* s = a->Attribute("xyz")) {
         if (!detail::parseVec3(s, j.axis)) throw fail("<axis xyz='" + std::string(s) + "'> is not three numbers");
+        // The axis gets normalized (here and by MuJoCo and ROS tools): its squared norm must be finite.
+        const double n2 = j.axis[0] * j.axis[0] + j.axis[1] * j.axis[1] + j.axis[2] * j.axis[2];
+        if (j.type != "fixed" && j.type != "floating" && !std::isfinite(n2)) {
+          throw fail("<axis xyz='" + std::string(s) + "'> is too large to normalize; give a unit vector");
+        }
       }
     }
     if (const TiXmlElement* lim = e->FirstChildElement("limit")) {
@@ -198,6 +206,29 @@ inline RawRobot scanUrdf(const std::string& xml) {
       detail::readNumber(lim, "upper", j.upper, false, fail);
       detail::readNumber(lim, "effort", j.effort, true, fail);
       detail::readNumber(lim, "velocity", j.velocity, true, fail);
+      if (j.type == "revolute" || j.type == "prismatic" || j.type == "continuous") {
+        // effort becomes the motor current limit and velocity a bound of the tasks: both must be
+        // positive (a negative effort would make the clamp's low bound exceed its high bound).
+        for (const char* attr : {"effort", "velocity"}) {
+          const double x = attr[0] == 'e' ? j.effort : j.velocity;
+          if (!std::isfinite(x) || x <= 0) {
+            throw fail("<limit " + std::string(attr) + "='" + lim->Attribute(attr) + "'> must be a finite number > 0");
+          }
+        }
+      }
+      if (j.type == "revolute" || j.type == "prismatic") {   // continuous joints ignore lower/upper
+        for (const char* attr : {"lower", "upper"}) {
+          const double x = attr[0] == 'l' ? j.lower : j.upper;
+          if (!std::isfinite(x)) {
+            throw fail("<limit " + std::string(attr) + "='" + lim->Attribute(attr) + "'> is not finite");
+          }
+        }
+        if (j.lower > j.upper) {
+          const std::string lo = lim->Attribute("lower") ? lim->Attribute("lower") : "0";
+          const std::string up = lim->Attribute("upper") ? lim->Attribute("upper") : "0";
+          throw fail("<limit lower='" + lo + "'> is above <limit upper='" + up + "'>");
+        }
+      }
     }
     if (!j.has_limit && (j.type == "revolute" || j.type == "prismatic")) {
       throw fail(j.type + " joint without <limit> (use a continuous joint for an unbounded rotation)");
