@@ -56,7 +56,7 @@ inline QpProblem decodeQp(FuzzedDataProvider& in, int n_max, int m_max, int me_m
     for (int i = 0; i < rows; ++i) {
       if (copies && i > 0 && in.ConsumeBool()) {
         const int k = in.ConsumeIntegralInRange<int>(0, i - 1);
-        M.row(i) = number(in) * M.row(k);
+        M.row(i) = (in.ConsumeIntegralInRange<int>(-4, 4) / 2.0) * M.row(k);  // exact multiple
         continue;
       }
       for (int j = 0; j < n; ++j) M(i, j) = number(in, special && (flags & 8));
@@ -107,9 +107,10 @@ inline QpProblem decodeQp(FuzzedDataProvider& in, int n_max, int m_max, int me_m
   return p;
 }
 
-// Tolerance of row c·x against a bound: relative to the size of the terms.
+// Tolerance of row c·x against a bound: the solvers' feasibility_tol (1e-9 per unit row, zero
+// rows unscaled) plus rounding relative to the size of the terms.
 inline double rowTol(const Eigen::VectorXd& c, const Eigen::VectorXd& x, double bound) {
-  return 1e-7 * (c.cwiseAbs().dot(x.cwiseAbs()) + c.norm() + (std::isfinite(bound) ? std::abs(bound) : 0.0));
+  return 1e-9 * std::max(c.norm(), 1.0) + 1e-7 * (c.cwiseAbs().dot(x.cwiseAbs()) + c.norm() + (std::isfinite(bound) ? std::abs(bound) : 0.0));
 }
 
 // x meets E x = e and lower ≤ C x ≤ upper to tolerance.
