@@ -167,8 +167,10 @@ inline void checkKkt(const QpProblem& p, const Eigen::VectorXd& x, const Eigen::
   }
   for (const ActiveRow& a : active)
     HQP_FUZZ_CHECK2(a.mu * p.C.row(a.row).norm() >= -1e-7 * mu_scale, a.mu, mu_scale);
+  // Normwise part: the rounding of b through the factorization, ‖A‖ (‖A‖ ‖x‖ + ‖b‖) ε.
+  const double normwise = p.A.norm() * (p.A.norm() * x.norm() + p.b.norm());
   for (int j = 0; j < g.size(); ++j)
-    HQP_FUZZ_CHECK2(std::abs(g(j)) <= 1e-7 * (scale(j) + scale.maxCoeff()) + 1e-12, g(j), scale(j));
+    HQP_FUZZ_CHECK2(std::abs(g(j)) <= 1e-7 * (scale(j) + scale.maxCoeff() + normwise) + 1e-12, g(j), scale(j));
 }
 
 inline double objective(const QpProblem& p, const Eigen::VectorXd& x) {
