@@ -8,6 +8,7 @@
 //    independently, which makes the dual answer wrong);
 //  - factorize() refuses exactly when A is (numerically) rank deficient: when it accepts, σ_min(A)
 //    from an SVD is not far below the promised bound.
+#include <memory>
 #include <vector>
 
 #include "hqp/active_set_qp.hpp"
@@ -83,7 +84,17 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (m > 0) primal.C() = p.C, primal.lower() = p.lower, primal.upper() = p.upper;
   primal.resetWorkingSet();
   const QpStatus sp = primal.solve(false);
-  if (std::getenv("HQP_FUZZ_VERBOSE")) std::fprintf(stderr, "primal status %s\n", hqp::toString(sp));
+  if (std::getenv("HQP_FUZZ_VERBOSE")) {
+    std::fprintf(stderr, "primal status %s, %d iterations\n", hqp::toString(sp), primal.iterations());
+    std::cerr << "primal x " << primal.x().transpose() << "\ndual x " << dual.x().transpose() << "\n";
+    auto fresh = std::make_unique<Primal>();
+    fresh->resize(n, r, 0, m);
+    fresh->A() = p.A;
+    fresh->b() = p.b;
+    if (m > 0) fresh->C() = p.C, fresh->lower() = p.lower, fresh->upper() = p.upper;
+    const QpStatus sf = fresh->solve(false);
+    std::cerr << "fresh primal " << hqp::toString(sf) << " x " << fresh->x().transpose() << "\n";
+  }
 
   // KKT residuals and the two optima are only compared where A is well conditioned
   // (κ(A) ≤ 1e7): beyond that, correct answers miss any fixed relative tolerance.
