@@ -121,6 +121,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"bad_negative_velocity.urdf", "joint 'knee': <limit velocity='-5'> must be a finite number > 0"},
         BadCase{"bad_continuous_negative_effort.urdf",
                 "joint 'knee': <limit effort='-20'> must be a finite number > 0"},
+        // Text from the file is escaped: the message stays one line.
+        BadCase{"bad_multiline_attribute.urdf", "link 'base': <inertia iyy='0.01\\n  kg'> is not a number"},
         BadCase{"bad_lower_above_upper.urdf", "joint 'knee': <limit lower='1'> is above <limit upper='-1'>"},
         // Caught by urdfdom only: its own message, after the file name.
         BadCase{"bad_urdfdom_safety.urdf", "urdfdom: joint safety: no k_velocity"}),

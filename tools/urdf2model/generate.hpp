@@ -42,7 +42,7 @@ inline std::string generate(const std::string& xml, const Options& opt, const st
 
   const Model model = buildModel(raw, opt);
   const std::string ns = ns_opt.empty() ? sanitize(model.name) : ns_opt;
-  if (!isNamespace(ns)) throw UrdfError("--namespace: '" + ns + "' is not a C++ namespace name");
+  if (!isNamespace(ns)) throw UrdfError("--namespace: " + quote(ns) + " is not a C++ namespace name");
   if (model_out) *model_out = model;
   return writeHeader(model, ns);
 }

@@ -150,7 +150,7 @@ inline void setInertia(const RawRobot& r, const Group& g, Body& b) {
   }
   if (m <= 0) {
     const std::string why = b.joint.empty() ? "it is the floating base"
-                                            : "joint '" + b.joint + "' moves it";
+                                            : "joint " + quote(b.joint) + " moves it";
     throw linkError(b.link, why + ", but it has no mass (no <inertial> on it or on a link fixed to it)");
   }
   b.mass = m;
@@ -285,7 +285,7 @@ inline Model buildModel(const RawRobot& r, const Options& opt) {
     std::set<std::string> wanted;
     for (const std::string& f : opt.frames) {
       const bool exists = std::any_of(all.begin(), all.end(), [&](const Frame& x) { return x.name == f; });
-      if (!exists) throw UrdfError("--frames: link '" + f + "' does not exist");
+      if (!exists) throw UrdfError("--frames: link " + quote(f) + " does not exist");
       wanted.insert(f);
     }
     for (std::size_t i = 0; i < all.size(); ++i) {
