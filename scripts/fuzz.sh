@@ -22,7 +22,11 @@ bash "$root/scripts/setup.sh" --fuzz
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_C_COMPILER=clang-14 \
       -DCMAKE_CXX_COMPILER=clang++-14 -DHQP_BUILD_FUZZERS=ON -DHQP_BUILD_TESTS=OFF \
       -DHQP_BUILD_BENCHMARKS=OFF -DHQP_BUILD_SIM_DEMO=OFF >/dev/null
-cmake --build "$build" -j"$(nproc)" --target "${fuzzers[@]}"
+if [ $# -eq 0 ]; then
+  cmake --build "$build" -j"$(nproc)" --target fuzzers   # all of them, in parallel
+else
+  cmake --build "$build" -j"$(nproc)" --target "${fuzzers[@]}"
+fi
 
 status=0
 for f in "${fuzzers[@]}"; do
