@@ -19,7 +19,7 @@ fuzzers=("$@")
 work="${HQP_FUZZ_DIR:-$build/run}"
 
 bash "$root/scripts/setup.sh" --fuzz
-cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_C_COMPILER=clang-14 \
+cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release \
       -DCMAKE_CXX_COMPILER=clang++-14 -DHQP_BUILD_FUZZERS=ON -DHQP_BUILD_TESTS=OFF \
       -DHQP_BUILD_BENCHMARKS=OFF -DHQP_BUILD_SIM_DEMO=OFF >/dev/null
 if [ $# -eq 0 ]; then
