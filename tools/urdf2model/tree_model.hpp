@@ -136,9 +136,13 @@ inline void addLinkInertia(const RawLink& raw, const Transform& T, double& mass,
   const Transform Ti = T * originTransform(raw.inertial_xyz, raw.inertial_rpy);
   const Eigen::Vector3d c = Ti.p;
   const Eigen::Matrix3d Ib = Ti.R * I * Ti.R.transpose();   // I_body = R I R^T
+  const Eigen::Matrix3d I_shift = Ib + in.mass * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
+  if (!c.allFinite() || !I_shift.allFinite()) {
+    throw linkError(raw.name, "<inertial> lies so far from the body origin that its inertia overflows");
+  }
   mass += in.mass;
   first_moment += in.mass * c;
-  I_origin += Ib + in.mass * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
+  I_origin += I_shift;
 }
 
 inline void setInertia(const RawRobot& r, const Group& g, Body& b) {
@@ -158,6 +162,9 @@ inline void setInertia(const RawRobot& r, const Group& g, Body& b) {
   // Back from the body origin to the CoM (parallel-axis theorem).
   b.inertia = I0 - m * (b.com.squaredNorm() * Eigen::Matrix3d::Identity() - b.com * b.com.transpose());
   b.inertia = 0.5 * (b.inertia + b.inertia.transpose()).eval();
+  if (!b.com.allFinite() || !b.inertia.allFinite()) {
+    throw linkError(b.link, "the body's CoM or inertia overflows (links fixed to it lie too far apart)");
+  }
 }
 
 inline void setJoint(const RawJoint& raw, Body& b) {
