@@ -123,6 +123,7 @@ INSTANTIATE_TEST_SUITE_P(
                 "joint 'knee': <limit effort='-20'> must be a finite number > 0"},
         // Text from the file is escaped: the message stays one line.
         BadCase{"bad_multiline_attribute.urdf", "link 'base': <inertia iyy='0.01\\n  kg'> is not a number"},
+        BadCase{"bad_urdfdom_multiline.urdf", "urdfdom: Unable to parse component [0.5\\n]"},
         BadCase{"bad_inertial_overflow.urdf", "link 'thigh': <inertial> lies so far from the body origin"},
         BadCase{"bad_lower_above_upper.urdf", "joint 'knee': <limit lower='1'> is above <limit upper='-1'>"},
         // Caught by urdfdom only: its own message, after the file name.

@@ -15,10 +15,10 @@ struct UrdfError : std::runtime_error {
 // Text from the file as it appears in a message: control characters (a newline inside an
 // attribute or a name) as C escapes, so that every message stays one line, and at most 60
 // characters.
-inline std::string printable(const std::string& s) {
+inline std::string printable(const std::string& s, std::size_t max_length = 60) {
   std::string out;
   for (unsigned char c : s) {
-    if (out.size() >= 60) return out + "...";
+    if (out.size() >= max_length) return out + "...";
     if (c == '\n') out += "\\n";
     else if (c == '\t') out += "\\t";
     else if (c == '\r') out += "\\r";

@@ -38,7 +38,10 @@ inline std::string generate(const std::string& xml, const Options& opt, const st
   console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_ERROR);
   const urdf::ModelInterfaceSharedPtr um = urdf::parseURDF(xml);
   console_bridge::noOutputHandler();
-  if (!um) throw UrdfError("urdfdom: " + (errors.message.empty() ? "cannot parse the file" : errors.message));
+  // urdfdom's message may quote the file's text, newlines included: kept on one line.
+  if (!um) {
+    throw UrdfError("urdfdom: " + (errors.message.empty() ? "cannot parse the file" : printable(errors.message, 300)));
+  }
 
   const Model model = buildModel(raw, opt);
   const std::string ns = ns_opt.empty() ? sanitize(model.name) : ns_opt;
