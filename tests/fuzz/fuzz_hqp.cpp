@@ -8,8 +8,9 @@
 //  - Optimal: x satisfies every constraint that was not dropped, and each level p, solved
 //    alone in the full 30 variables by a fresh ActiveSetQp with the higher levels' task values
 //    A_k x = A_k x* (k < p) as equalities and the constraints of levels ≤ p, reaches the same
-//    residual (HqpWbc's residual is not larger than that optimum); a level whose constraints
-//    that reference finds infeasible must report them dropped.
+//    residual (HqpWbc's residual is not larger than that optimum). Levels whose constraints
+//    HqpWbc reports dropped are solved without them; where the reference gives no answer,
+//    the comparison stops.
 #include <memory>
 #include <random>
 #include <vector>
