@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs every Debian 12 package the build, tests, benchmarks and demo need.
 # Idempotent: skips the install when every package is already present.
-# --demo adds what only the MuJoCo demo needs (ffmpeg for the MP4).
+# --demo adds what only the MuJoCo demo needs (ffmpeg for the MP4); --fuzz adds clang-14 and
+# its libFuzzer/sanitizer runtimes for tests/fuzz (scripts/fuzz.sh; scripts/test.sh runs them).
 set -euo pipefail
 
 PACKAGES=(
@@ -13,9 +14,13 @@ PACKAGES=(
   liblodepng-dev
   python3 python3-numpy python3-scipy python3-matplotlib
 )
-if [ "${1:-}" = "--demo" ]; then
-  PACKAGES+=(ffmpeg)
-fi
+for arg in "$@"; do
+  case "$arg" in
+    --demo) PACKAGES+=(ffmpeg) ;;
+    --fuzz) PACKAGES+=(clang-14 libclang-rt-14-dev llvm-14) ;;
+    *) echo "setup: unknown option $arg" >&2; exit 2 ;;
+  esac
+done
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -5,7 +5,7 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build="${HQP_BUILD_DIR:-$root/build}"
 jobs=$(nproc)
 
-bash "$root/scripts/setup.sh"
+bash "$root/scripts/setup.sh" --fuzz
 start=$(date +%s)
 # Benchmarks are built and run by scripts/bench.sh (-O3 -march=native builds take ~5 of the
 # CI's minutes; docs/development.md "Build and CI cost").
@@ -14,11 +14,23 @@ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release \
 cmake --build "$build" -j"$jobs"
 built=$(date +%s)
 
+# Sanitizer subset (preset asan) and the fuzzers' regression run (docs/development.md).
+set +e
+bash "$root/scripts/sanitize.sh"
+asan=$?
+HQP_FUZZ_BUILD_DIR="${HQP_FUZZ_BUILD_DIR:-$root/build-fuzz}" bash "$root/scripts/fuzz.sh" --ci
+fuzz=$?
+set -e
+extra=$(date +%s)
+
 set +e
 ctest --test-dir "$build" --output-on-failure -j"$jobs" --timeout 900
 status=$?
 set -e
 end=$(date +%s)
 echo
-echo "== test summary: build $((built - start)) s, tests $((end - built)) s; ctest exit code $status =="
+echo "== sanitizer tests exit code $asan, fuzz regression exit code $fuzz ($((extra - built)) s) =="
+echo "== test summary: build $((built - start)) s, tests $((end - extra)) s; ctest exit code $status =="
+[ $status -ne 0 ] || [ $asan -eq 0 ] || status=1
+[ $status -ne 0 ] || [ $fuzz -eq 0 ] || status=1
 exit $status

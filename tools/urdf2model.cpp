@@ -4,8 +4,6 @@
 // stderr when the URDF is rejected (docs/adding-a-robot.md lists the rules).
 
 #include <CLI/CLI.hpp>
-#include <console_bridge/console.h>
-#include <urdf_parser/urdf_parser.h>
 
 #include <cstdio>
 #include <fstream>
@@ -14,40 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "urdf2model/error.hpp"
-#include "urdf2model/header_writer.hpp"
-#include "urdf2model/tree_model.hpp"
-#include "urdf2model/xml_scan.hpp"
-
-namespace {
-
-// Keeps urdfdom's first error instead of letting it print several lines.
-class FirstError : public console_bridge::OutputHandler {
- public:
-  void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
-    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR && message.empty()) message = text;
-  }
-  std::string message;
-};
-
-std::string generate(const std::string& xml, const hqp::tools::Options& opt, const std::string& ns_opt) {
-  using namespace hqp::tools;
-  const RawRobot raw = scanUrdf(xml);
-
-  FirstError errors;
-  console_bridge::useOutputHandler(&errors);
-  console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_ERROR);
-  const urdf::ModelInterfaceSharedPtr um = urdf::parseURDF(xml);
-  console_bridge::noOutputHandler();
-  if (!um) throw UrdfError("urdfdom: " + (errors.message.empty() ? "cannot parse the file" : errors.message));
-
-  const Model model = buildModel(raw, opt);
-  const std::string ns = ns_opt.empty() ? sanitize(model.name) : ns_opt;
-  if (!isNamespace(ns)) throw UrdfError("--namespace: '" + ns + "' is not a C++ namespace name");
-  return writeHeader(model, ns);
-}
-
-}  // namespace
+#include "urdf2model/generate.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"Writes a constexpr C++ robot description (hqp::model) from a URDF."};
@@ -72,7 +37,7 @@ int main(int argc, char** argv) {
 
   std::string header;
   try {
-    header = generate(buf.str(), opt, ns);
+    header = hqp::tools::generate(buf.str(), opt, ns);
   } catch (const hqp::tools::UrdfError& e) {
     std::remove(out_path.c_str());   // no stale header that would let a build pass
     std::cerr << urdf_path << ": " << e.what() << "\n";

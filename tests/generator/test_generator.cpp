@@ -114,6 +114,18 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"bad_duplicate_link.urdf", "link 'thigh': defined twice"},
         BadCase{"bad_revolute_without_limit.urdf", "joint 'knee': revolute joint without <limit>"},
         BadCase{"bad_xml.urdf", "line 5: XML error"},
+        // Input contract of numbers: finite, physically valid, checked before anything uses them.
+        BadCase{"bad_axis_overflow.urdf", "joint 'knee': <axis xyz='1e200 1e200 1e200'> is too large"},
+        BadCase{"bad_negative_effort.urdf", "joint 'knee': <limit effort='-20'> must be a finite number > 0"},
+        BadCase{"bad_zero_effort.urdf", "joint 'knee': <limit effort='0'> must be a finite number > 0"},
+        BadCase{"bad_negative_velocity.urdf", "joint 'knee': <limit velocity='-5'> must be a finite number > 0"},
+        BadCase{"bad_continuous_negative_effort.urdf",
+                "joint 'knee': <limit effort='-20'> must be a finite number > 0"},
+        // Text from the file is escaped: the message stays one line.
+        BadCase{"bad_multiline_attribute.urdf", "link 'base': <inertia iyy='0.01\\n  kg'> is not a number"},
+        BadCase{"bad_urdfdom_multiline.urdf", "urdfdom: Unable to parse component [0.5\\n]"},
+        BadCase{"bad_inertial_overflow.urdf", "link 'thigh': <inertial> lies so far from the body origin"},
+        BadCase{"bad_lower_above_upper.urdf", "joint 'knee': <limit lower='1'> is above <limit upper='-1'>"},
         // Caught by urdfdom only: its own message, after the file name.
         BadCase{"bad_urdfdom_safety.urdf", "urdfdom: joint safety: no k_velocity"}),
     [](const ::testing::TestParamInfo<BadCase>& info) {
@@ -121,6 +133,18 @@ INSTANTIATE_TEST_SUITE_P(
       n = n.substr(4, n.size() - 9);   // strip "bad_" and ".urdf"
       return n;
     });
+
+// With a fixed base the links fused into the world drop their inertia, but a negative mass
+// is still an error in the file (docs/adding-a-robot.md: mass >= 0 on every link).
+TEST(GeneratorCli, RejectsNegativeMassOnALinkFusedIntoTheWorld) {
+  const std::string urdf = kData + "/bad_world_negative_mass.urdf";
+  const std::string out = tmpPath("bad_world_negative_mass.hpp");
+  std::remove(out.c_str());
+  const RunResult r = runGenerator("'" + urdf + "' -o '" + out + "'");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.output, urdf + ": link 'plate': negative or invalid mass -2\n");
+  EXPECT_FALSE(std::filesystem::exists(out)) << "no header may be written";
+}
 
 TEST(GeneratorCli, RejectsUnknownFrame) {
   const std::string urdf = kData + "/fused_pair.urdf";

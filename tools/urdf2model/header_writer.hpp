@@ -115,7 +115,7 @@ inline std::vector<std::pair<std::string, int>> identifiers(const std::vector<st
       std::string a = it->second, b = names[i];
       if (b < a) std::swap(a, b);
       throw UrdfError(kind + " " + quote(b) + ": name collides with " + kind + " " + quote(a) +
-                      " after sanitization (both become '" + id + "')");
+                      " after sanitization (both become " + quote(id) + ")");
     }
     seen[id] = names[i];
     out.emplace_back(id, i);

@@ -136,9 +136,13 @@ inline void addLinkInertia(const RawLink& raw, const Transform& T, double& mass,
   const Transform Ti = T * originTransform(raw.inertial_xyz, raw.inertial_rpy);
   const Eigen::Vector3d c = Ti.p;
   const Eigen::Matrix3d Ib = Ti.R * I * Ti.R.transpose();   // I_body = R I R^T
+  const Eigen::Matrix3d I_shift = Ib + in.mass * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
+  if (!c.allFinite() || !I_shift.allFinite()) {
+    throw linkError(raw.name, "<inertial> lies so far from the body origin that its inertia overflows");
+  }
   mass += in.mass;
   first_moment += in.mass * c;
-  I_origin += Ib + in.mass * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
+  I_origin += I_shift;
 }
 
 inline void setInertia(const RawRobot& r, const Group& g, Body& b) {
@@ -150,7 +154,7 @@ inline void setInertia(const RawRobot& r, const Group& g, Body& b) {
   }
   if (m <= 0) {
     const std::string why = b.joint.empty() ? "it is the floating base"
-                                            : "joint '" + b.joint + "' moves it";
+                                            : "joint " + quote(b.joint) + " moves it";
     throw linkError(b.link, why + ", but it has no mass (no <inertial> on it or on a link fixed to it)");
   }
   b.mass = m;
@@ -158,12 +162,18 @@ inline void setInertia(const RawRobot& r, const Group& g, Body& b) {
   // Back from the body origin to the CoM (parallel-axis theorem).
   b.inertia = I0 - m * (b.com.squaredNorm() * Eigen::Matrix3d::Identity() - b.com * b.com.transpose());
   b.inertia = 0.5 * (b.inertia + b.inertia.transpose()).eval();
+  if (!b.com.allFinite() || !b.inertia.allFinite()) {
+    throw linkError(b.link, "the body's CoM or inertia overflows (links fixed to it lie too far apart)");
+  }
 }
 
 inline void setJoint(const RawJoint& raw, Body& b) {
   const Eigen::Vector3d axis(raw.axis[0], raw.axis[1], raw.axis[2]);
-  if (!axis.allFinite() || axis.norm() < 1e-12) throw jointError(raw.name, "zero axis");
-  b.axis = axis.normalized();
+  // The scan rejects axes whose squared norm overflows; an inf norm would normalize to (0, 0, 0).
+  const double norm = axis.norm();
+  if (!axis.allFinite() || !std::isfinite(norm)) throw jointError(raw.name, "the axis is not a finite direction");
+  if (norm < 1e-12) throw jointError(raw.name, "zero axis");
+  b.axis = axis / norm;
   b.lower = -kInf;
   b.upper = kInf;
   b.velocity = kInf;
@@ -282,7 +292,7 @@ inline Model buildModel(const RawRobot& r, const Options& opt) {
     std::set<std::string> wanted;
     for (const std::string& f : opt.frames) {
       const bool exists = std::any_of(all.begin(), all.end(), [&](const Frame& x) { return x.name == f; });
-      if (!exists) throw UrdfError("--frames: link '" + f + "' does not exist");
+      if (!exists) throw UrdfError("--frames: link " + quote(f) + " does not exist");
       wanted.insert(f);
     }
     for (std::size_t i = 0; i < all.size(); ++i) {

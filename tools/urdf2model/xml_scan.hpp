@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <locale>
 #include <map>
 #include <sstream>
@@ -75,7 +76,7 @@ inline void readOrigin(const TiXmlElement* parent, Vec3& xyz, Vec3& rpy,
   const TiXmlElement* o = parent->FirstChildElement("origin");
   if (o == nullptr) return;
   auto fail = [&](const char* attr, const char* value) {
-    const std::string what = "<origin " + std::string(attr) + "='" + value + "'> is not three numbers";
+    const std::string what = "<origin " + std::string(attr) + "=" + quote(value) + "> is not three numbers";
     return owner_kind == "joint" ? jointError(owner, what) : linkError(owner, what);
   };
   if (const char* s = o->Attribute("xyz")) {
@@ -103,7 +104,7 @@ void readNumber(const TiXmlElement* e, const char* attr, double& out, bool requi
     return;
   }
   if (!parseNumber(s, out)) {
-    throw fail("<" + std::string(e->Value()) + " " + attr + "='" + s + "'> is not a number");
+    throw fail("<" + std::string(e->Value()) + " " + attr + "=" + quote(s) + "> is not a number");
   }
 }
 
@@ -142,6 +143,8 @@ inline RawRobot scanUrdf(const std::string& xml) {
       const TiXmlElement* mass = in->FirstChildElement("mass");
       if (mass == nullptr) throw fail("<inertial> has no <mass>");
       detail::readNumber(mass, "value", l.mass, true, fail);
+      // Checked here for every link, also those fused into a fixed base (whose inertia is dropped).
+      if (!std::isfinite(l.mass) || l.mass < 0) throw fail("negative or invalid mass " + show(l.mass));
       const TiXmlElement* I = in->FirstChildElement("inertia");
       if (I == nullptr) throw fail("<inertial> has no <inertia>");
       detail::readNumber(I, "ixx", l.ixx, true, fail);
@@ -167,7 +170,7 @@ inline RawRobot scanUrdf(const std::string& xml) {
     if (j.type == "planar") throw jointError(j.name, "planar joints are not supported");
     if (j.type != "revolute" && j.type != "continuous" && j.type != "prismatic" &&
         j.type != "fixed" && j.type != "floating") {
-      throw jointError(j.name, "unknown joint type '" + j.type + "'");
+      throw jointError(j.name, "unknown joint type " + quote(j.type) + "");
     }
     if (e->FirstChildElement("mimic") != nullptr) {
       throw jointError(j.name, "mimic joints are not supported (model the coupling as a task)");
@@ -177,19 +180,24 @@ inline RawRobot scanUrdf(const std::string& xml) {
     if (j.parent.empty()) throw jointError(j.name, "no <parent link=...>");
     if (j.child.empty()) throw jointError(j.name, "no <child link=...>");
     if (!r.link_index.count(j.parent)) {
-      throw jointError(j.name, "parent link '" + j.parent + "' does not exist");
+      throw jointError(j.name, "parent link " + quote(j.parent) + " does not exist");
     }
     if (!r.link_index.count(j.child)) {
-      throw jointError(j.name, "child link '" + j.child + "' does not exist");
+      throw jointError(j.name, "child link " + quote(j.child) + " does not exist");
     }
     if (j.parent == j.child) {
-      throw jointError(j.name, "joins link '" + j.child + "' to itself (kinematic loop)");
+      throw jointError(j.name, "joins link " + quote(j.child) + " to itself (kinematic loop)");
     }
     detail::readOrigin(e, j.xyz, j.rpy, "joint", j.name);
     auto fail = [&](const std::string& what) { return jointError(j.name, what); };
     if (const TiXmlElement* a = e->FirstChildElement("axis")) {
       if (const char* s = a->Attribute("xyz")) {
-        if (!detail::parseVec3(s, j.axis)) throw fail("<axis xyz='" + std::string(s) + "'> is not three numbers");
+        if (!detail::parseVec3(s, j.axis)) throw fail("<axis xyz=" + quote(s) + "> is not three numbers");
+        // The axis gets normalized (here and by MuJoCo and ROS tools): its squared norm must be finite.
+        const double n2 = j.axis[0] * j.axis[0] + j.axis[1] * j.axis[1] + j.axis[2] * j.axis[2];
+        if (j.type != "fixed" && j.type != "floating" && !std::isfinite(n2)) {
+          throw fail("<axis xyz=" + quote(s) + "> is too large to normalize; give a unit vector");
+        }
       }
     }
     if (const TiXmlElement* lim = e->FirstChildElement("limit")) {
@@ -198,6 +206,29 @@ inline RawRobot scanUrdf(const std::string& xml) {
       detail::readNumber(lim, "upper", j.upper, false, fail);
       detail::readNumber(lim, "effort", j.effort, true, fail);
       detail::readNumber(lim, "velocity", j.velocity, true, fail);
+      if (j.type == "revolute" || j.type == "prismatic" || j.type == "continuous") {
+        // effort becomes the motor current limit and velocity a bound of the tasks: both must be
+        // positive (a negative effort would make the clamp's low bound exceed its high bound).
+        for (const char* attr : {"effort", "velocity"}) {
+          const double x = attr[0] == 'e' ? j.effort : j.velocity;
+          if (!std::isfinite(x) || x <= 0) {
+            throw fail("<limit " + std::string(attr) + "=" + quote(lim->Attribute(attr)) + "> must be a finite number > 0");
+          }
+        }
+      }
+      if (j.type == "revolute" || j.type == "prismatic") {   // continuous joints ignore lower/upper
+        for (const char* attr : {"lower", "upper"}) {
+          const double x = attr[0] == 'l' ? j.lower : j.upper;
+          if (!std::isfinite(x)) {
+            throw fail("<limit " + std::string(attr) + "=" + quote(lim->Attribute(attr)) + "> is not finite");
+          }
+        }
+        if (j.lower > j.upper) {
+          const std::string lo = lim->Attribute("lower") ? lim->Attribute("lower") : "0";
+          const std::string up = lim->Attribute("upper") ? lim->Attribute("upper") : "0";
+          throw fail("<limit lower=" + quote(lo) + "> is above <limit upper=" + quote(up) + ">");
+        }
+      }
     }
     if (!j.has_limit && (j.type == "revolute" || j.type == "prismatic")) {
       throw fail(j.type + " joint without <limit> (use a continuous joint for an unbounded rotation)");
@@ -217,8 +248,8 @@ inline RawRobot scanUrdf(const std::string& xml) {
     if (it != r.parent_joint.end()) {
       std::string a = r.joints[it->second].name, b = j.name;
       if (b < a) std::swap(a, b);
-      throw linkError(j.child, "has two parents (joints '" + a + "' and '" + b +
-                                   "'): kinematic loops are not supported");
+      throw linkError(j.child, "has two parents (joints " + quote(a) + " and " + quote(b) +
+                                   "): kinematic loops are not supported");
     }
     r.parent_joint[j.child] = k;
     r.child_joints[j.parent].push_back(k);
@@ -242,7 +273,7 @@ inline RawRobot scanUrdf(const std::string& xml) {
              c = r.joints[r.parent_joint[c]].parent) {
           first = std::min(first, r.joints[r.parent_joint[c]].name);
         }
-        throw jointError(first, "closes a kinematic loop (through link '" + l.name + "')");
+        throw jointError(first, "closes a kinematic loop (through link " + quote(l.name) + ")");
       }
     }
   }
@@ -253,8 +284,8 @@ inline RawRobot scanUrdf(const std::string& xml) {
   }
   if (roots.size() > 1) {
     std::sort(roots.begin(), roots.end());
-    throw linkError(roots[1], "has no parent joint, and neither has link '" + roots[0] +
-                                  "': the links must form one tree");
+    throw linkError(roots[1], "has no parent joint, and neither has link " + quote(roots[0]) +
+                                  ": the links must form one tree");
   }
   r.root = roots.at(0);
   return r;

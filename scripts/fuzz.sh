@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer harnesses of tests/fuzz with clang-14 and runs each for N minutes
+# (default 10), one after the other (docs/fuzzing.md). Prints, per fuzzer, the executions,
+# the corpus size and any finding (crash-*/leak-*/timeout-* files, kept in the work folder).
+#   scripts/fuzz.sh [minutes] [fuzzer...]
+#   scripts/fuzz.sh --ci          the CI regression: the fixed seed corpus, then a fixed-seed
+#                                 mutation run of HQP_FUZZ_CI_SECONDS (default 20) s per fuzzer,
+#                                 with the known findings skipped (HQP_FUZZ_SKIP_KNOWN=1)
+# Exit code 1 if any fuzzer reported a finding. Work folder: $HQP_FUZZ_DIR (default build-fuzz/run).
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+build="${HQP_FUZZ_BUILD_DIR:-$root/build-fuzz}"
+ci=0
+minutes=10
+if [ "${1:-}" = "--ci" ]; then ci=1; shift; elif [[ "${1:-}" =~ ^[0-9.]+$ ]]; then minutes=$1; shift; fi
+all=(fuzz_active_set_qp fuzz_dual_qp fuzz_hqp fuzz_controller_tick fuzz_urdf_generator)
+fuzzers=("$@")
+[ ${#fuzzers[@]} -gt 0 ] || fuzzers=("${all[@]}")
+work="${HQP_FUZZ_DIR:-$build/run}"
+
+bash "$root/scripts/setup.sh" --fuzz
+cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release \
+      -DCMAKE_CXX_COMPILER=clang++-14 -DHQP_BUILD_FUZZERS=ON -DHQP_BUILD_TESTS=OFF \
+      -DHQP_BUILD_BENCHMARKS=OFF -DHQP_BUILD_SIM_DEMO=OFF >/dev/null
+if [ $# -eq 0 ]; then
+  cmake --build "$build" -j"$(nproc)" --target fuzzers   # all of them, in parallel
+else
+  cmake --build "$build" -j"$(nproc)" --target "${fuzzers[@]}"
+fi
+
+status=0
+for f in "${fuzzers[@]}"; do
+  dir="$work/$f"
+  mkdir -p "$dir/corpus" "$dir/artifacts"
+  rm -f "$dir"/artifacts/*
+  if [ $ci -eq 1 ]; then
+    rm -rf "$dir/corpus" && mkdir -p "$dir/corpus"
+  fi
+  python3 "$root/tests/fuzz/make_seeds.py" "$f" "$dir/corpus" 300
+  opts=(-artifact_prefix="$dir/artifacts/" -print_final_stats=1 -max_len=4096)
+  [ "$f" = fuzz_urdf_generator ] && opts+=(-dict="$root/tests/fuzz/urdf.dict")
+  if [ $ci -eq 1 ]; then
+    export HQP_FUZZ_SKIP_KNOWN=1
+    opts+=(-seed=1 -max_total_time="${HQP_FUZZ_CI_SECONDS:-20}")
+  else
+    opts+=(-max_total_time="$(python3 -c "print(int(float('$minutes') * 60))")")
+  fi
+  start=$(date +%s)
+  set +e
+  "$build/tests/fuzz/$f" "${opts[@]}" "$dir/corpus" >"$dir/log.txt" 2>&1
+  rc=$?
+  set -e
+  secs=$(( $(date +%s) - start ))
+  execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$dir/log.txt" | tail -1)
+  findings=$(find "$dir/artifacts" -type f | wc -l)
+  echo "== $f: ${execs:-?} executions in $secs s, corpus $(find "$dir/corpus" -type f | wc -l) files, findings $findings, exit code $rc"
+  if [ $rc -ne 0 ] || [ "$findings" -ne 0 ]; then
+    status=1
+    grep -m3 -E "FUZZ FINDING|ERROR: AddressSanitizer|runtime error|ERROR: libFuzzer" "$dir/log.txt" | sed 's/^/   /' || true
+    find "$dir/artifacts" -type f | sed 's/^/   input: /'
+  fi
+done
+exit $status

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# The sanitizer job of CI (docs/development.md, "Build and CI cost"): the CMake preset `asan`
+# (GCC, -fsanitize=address,undefined at -O1) builds a subset of the test suites (the QP solvers,
+# the state estimator) and runs them; the fuzzers cover HqpWbc and the controller tick under
+# ASan+UBSan (docs/development.md).
+# Any ASan/UBSan report fails the test binary. Extra arguments replace the list of test targets.
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+targets=("$@")
+[ ${#targets[@]} -gt 0 ] || targets=(test_qp_dual test_qp_random test_state_estimator)
+cd "$root"
+cmake --preset asan >/dev/null
+if [ $# -eq 0 ]; then
+  cmake --build build-asan -j"$(nproc)" --target hqp_asan_subset   # the targets in parallel
+else
+  cmake --build build-asan -j"$(nproc)" --target "${targets[@]}"
+fi
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+status=0
+for t in "${targets[@]}"; do
+  bin=$(find build-asan/tests -type f -name "$t" -perm -u+x | head -1)
+  set +e
+  out=$("$bin" --gtest_brief=1 2>&1)
+  rc=$?
+  set -e
+  echo "== asan $t: $(echo "$out" | grep -E '^\[  (PASSED|FAILED) ' | tr '\n' ' ')exit code $rc"
+  if [ $rc -ne 0 ]; then
+    status=1
+    echo "$out" | grep -E "ERROR: AddressSanitizer|runtime error|FAILED" | head -5 | sed 's/^/   /'
+  fi
+done
+exit $status
