@@ -105,7 +105,7 @@ nlohmann::ordered_json runRecord(const ScenarioParams& p, const RunSummary& r) {
   nlohmann::ordered_json levels = nlohmann::ordered_json::array();
   for (int l = 0; l < r.num_levels; ++l) {
     nlohmann::ordered_json c;
-    for (int s = 0; s < 4; ++s) c[toString(static_cast<QpStatus>(s))] = r.level_status_counts[l][s];
+    for (int s = 0; s < RunSummary::kStatuses; ++s) c[toString(static_cast<QpStatus>(s))] = r.level_status_counts[l][s];
     levels.push_back(c);
   }
   j["level_status_counts"] = levels;
@@ -237,10 +237,12 @@ void printRecord(std::FILE* out, const nlohmann::ordered_json& j) {
     int l = 1;
     for (const auto& c : j["level_status_counts"]) {
       std::fprintf(out, " L%d %ld opt", l++, c["Optimal"].get<long>());
-      const long bad = c["Infeasible"].get<long>() + c["IterationLimit"].get<long>() + c["NumericalFailure"].get<long>();
+      const long bad = c["Infeasible"].get<long>() + c["IterationLimit"].get<long>() + c["NumericalFailure"].get<long>() +
+                       c["InvalidInput"].get<long>();
       if (bad > 0) {
         std::fprintf(out, " (%ld infeasible, %ld iteration limit, %ld numerical)", c["Infeasible"].get<long>(),
                      c["IterationLimit"].get<long>(), c["NumericalFailure"].get<long>());
+        if (c["InvalidInput"].get<long>() > 0) std::fprintf(out, " (%ld invalid input)", c["InvalidInput"].get<long>());
       }
       std::fprintf(out, ";");
     }

@@ -241,7 +241,7 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
       r.num_levels = std::min(solver.num_levels, kMaxLevels);
       for (int l = 0; l < r.num_levels; ++l) {
         const int st = solver.level_status[l];
-        if (st >= 0 && st < 4) ++r.level_status_counts[l][st];
+        if (st >= 0 && st < RunSummary::kStatuses) ++r.level_status_counts[l][st];
       }
       if (r.num_levels > 0) {
         const double e = solver.level_residual[r.num_levels - 1];

@@ -177,7 +177,8 @@ struct RunSummary {
   // Solver: per level the count of ticks by status (hqp::QpStatus order), and the lowest level's
   // task error ||A x - b||^2 (the paper's Fig. 9(b)).
   int num_levels = 0;
-  std::array<std::array<long, 4>, kMaxLevels> level_status_counts{};
+  static constexpr int kStatuses = 5;  // hqp::QpStatus values, Optimal … InvalidInput
+  std::array<std::array<long, kStatuses>, kMaxLevels> level_status_counts{};
   double lowest_level_error_max = 0, lowest_level_error_mean = 0;
   // Moving supports: per foot the peak |component| of the sole's velocity (ground truth from
   // MuJoCo, world axes, low-passed at foot_velocity_cutoff) until the first ZMP outside a sole
