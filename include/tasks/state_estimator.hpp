@@ -289,10 +289,11 @@ class StateEstimator {
       }
     } else {
       const Eigen::Vector3d g(0.0, 0.0, -hqp::model::kGravity);
+      const Eigen::Vector3d a_world = quat_wi * s.imu_accel + g;  // before the bias
+      const Eigen::Vector3d dv = dt * (a_world - filter_.bias());   // this tick's velocity change
       // Trust from the predicted velocity, before this tick's measurements.
-      const Eigen::Vector3d v_pred =
-          filter_.velocity() + dt * (quat_wi * s.imu_accel + g - filter_.bias());
-      filter_.predict(quat_wi * s.imu_accel + g, dt, p_.noise);
+      const Eigen::Vector3d v_pred = filter_.velocity() + dv;
+      filter_.predict(a_world, dt, p_.noise);
       const double gate2 = p_.zero_velocity_gate * p_.zero_velocity_gate * filter_.covariance()(1, 1) +
                            p_.stationary_velocity * p_.stationary_velocity;
       // Loaded feet that pass the gate and agree with the stillest loaded foot (relative
@@ -309,7 +310,6 @@ class StateEstimator {
       // that accelerates does not.
       const double ag = lowPassGain(p_.gate_cutoff, dt);
       const double hp = 1.0 - lowPassGain(p_.motion_cutoff, dt);
-      const Eigen::Vector3d dv = dt * (quat_wi * s.imu_accel + g - filter_.bias());
       for (int c = 0; c < NC; ++c) {
         u_gate_[c] += ag * (u[c] - u_gate_[c]);
         motion_hp_[c] = hp * (motion_hp_[c] + dv + u[c] - u_last_[c]);

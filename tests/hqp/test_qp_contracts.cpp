@@ -247,17 +247,6 @@ RankDeficientQp makeRankDeficient(std::mt19937& g) {
 
 using Qp28 = hqp::ActiveSetQp<28, 40, 1, 9>;
 
-void load(Qp28& qp, const RankDeficientQp& p) {
-  qp.resize(28, static_cast<int>(p.A.rows()), 1, 9);
-  qp.A() = p.A;
-  qp.b() = p.b;
-  qp.E() = p.E;
-  qp.e() = p.e;
-  qp.C() = p.C;
-  qp.lower() = p.lower;
-  qp.upper() = p.upper;
-}
-
 // KKT of the reported solution, computed here: feasibility, μ ≥ 0, complementarity (the
 // returned error) and stationarity Aᵀ(Ax − b) + Eᵀλ + Σ ±μ c = 0 relative to its terms
 // (*stat, not asserted: with column scales over six decades and rank-deficient A it is not a
@@ -294,7 +283,7 @@ TEST(QpContracts, RankDeficientFeasibleProblemsAreSolved) {
     std::mt19937 g(static_cast<unsigned>(seed));
     RankDeficientQp p = makeRankDeficient(g);
     qp.resetWorkingSet();
-    load(qp, p);
+    hqp::testing::loadInto(qp, p);
     ++total;
     if (qp.solve(false) != hqp::QpStatus::Optimal) {
       ++failures;
@@ -313,7 +302,7 @@ TEST(QpContracts, RankDeficientFeasibleProblemsAreSolved) {
       qp.b() = p.b;
       const hqp::QpStatus sw = qp.solve(true);
       cold.resetWorkingSet();
-      load(cold, p);
+      hqp::testing::loadInto(cold, p);
       const hqp::QpStatus sc = cold.solve(false);
       if (sc == hqp::QpStatus::Optimal && sw != hqp::QpStatus::Optimal) ++warm_failures;
       if (sw == hqp::QpStatus::Optimal) {
@@ -336,7 +325,7 @@ TEST(QpContracts, RankDeficientMatchesEnumeration) {
     RankDeficientQp p = makeRankDeficient(g);
     static Qp28 qp;
     qp.resetWorkingSet();
-    load(qp, p);
+    hqp::testing::loadInto(qp, p);
     const hqp::QpStatus s = qp.solve(false);
     if (s != hqp::QpStatus::Optimal) continue;  // counted by the test above
     const auto ref = hqp::testing::bruteForceQp(p.A, p.b, p.E, p.e, p.C, p.lower, p.upper, 1e-7);
@@ -358,7 +347,7 @@ TEST(QpContracts, OptimalIsFeasibleOnNearlySingularA) {
     for (Eigen::Index i = 0; i < p.A.size(); ++i) p.A.data()[i] += 1e-11 * U(g);
     p.b *= 100.0;
     qp.resetWorkingSet();
-    load(qp, p);
+    hqp::testing::loadInto(qp, p);
     const hqp::QpStatus s = qp.solve(false);
     EXPECT_TRUE(qp.x().allFinite());
     if (s != hqp::QpStatus::Optimal) continue;
