@@ -28,7 +28,7 @@ struct SweepParams {
 // friction_ablation: every base scenario under every friction-compensation variant
 // (friction_ablation.hpp lists the variants).
 struct AblationParams {
-  // push_x: friction under pushes; stand: where compensation matters most; seesaw_y: a moving support (issue 6).
+  // push_x: friction under pushes; stand: where compensation matters most; seesaw_y: a moving support.
   std::vector<std::string> scenarios = {"push_x", "stand", "seesaw_y"};
   std::vector<std::string> variants = {"on", "off", "low", "high", "config", "on_kdq0", "off_kdq0"};
 };
@@ -53,7 +53,7 @@ struct ScenarioParams {
   std::string estimator = "config";       // config (controller YAML's), stance or kinematic_inertial
   bool ablation = false;                  // friction_ablation: runs instead of one run
   AblationParams ablation_params;
-  // Moving supports (issue 6): the scene file (in the directory of the default scene.xml) and
+  // Moving supports: the scene file (in the directory of the default scene.xml) and
   // one motion per servo axis of kSupportAxes (amplitude 0 and offset 0: not driven).
   std::string scene = "scene.xml";
   std::vector<SupportMotion> supports;

@@ -1,5 +1,5 @@
 #pragma once
-// Moving supports (seesaw, skateboards; issue 6, docs/scenarios.md): the target of one board
+// Moving supports (seesaw, skateboards; docs/scenarios.md): the target of one board
 // servo over time. A sinusoid about an offset, faded in and out by a raised-cosine window so the
 // board starts and stops without a velocity step. Not real-time code (the simulator side).
 

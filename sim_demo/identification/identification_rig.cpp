@@ -548,7 +548,7 @@ int main(int argc, char** argv) {
     const SeedResult& R = results.back();
     ok = ok && R.ok;
     target = target && R.met_applied == Robot::nj && R.met_band == Robot::nj;
-    std::printf("seed %u: issue target (RMS < 1 N m and >= 5x below CAD) met on %d of %d joints vs the "
+    std::printf("seed %u: accuracy target (RMS < 1 N m and >= 5x below CAD) met on %d of %d joints vs the "
                 "applied torque, %d vs the band-limited measured torque (%d vs the raw measured torque)\n",
                 seeds[i], R.met_applied, Robot::nj, R.met_band, R.met_meas);
   }
@@ -585,7 +585,7 @@ int main(int argc, char** argv) {
               "model better than CAD and < 1 N m RMS while moving, on %s joint of %s seed\n",
               ok ? "PASS" : "FAIL", ok ? "every" : "not every", ok ? "every" : "some");
   if (require_target) {
-    std::printf("%s: issue target on every joint of every seed (applied and band-limited measured torque)\n",
+    std::printf("%s: accuracy target on every joint of every seed (applied and band-limited measured torque)\n",
                 target ? "PASS" : "FAIL");
   }
   return ok && (!require_target || target) ? 0 : 1;

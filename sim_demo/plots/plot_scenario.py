@@ -6,7 +6,7 @@ Writes, for RUN.csv with stem S:
   DIR/S_fig9.png   measured vs optimized ZMP per foot in the sole frame, and the lowest-level
                    task error ||A x - b||^2 on a log axis (paper Fig. 9)
   DIR/S_fig13.png  controller compute time per tick and its histogram (paper Fig. 13)
-and for runs on moving supports (the CSV has support_<axis> columns, issue 6):
+and for runs on moving supports (the CSV has support_<axis> columns):
   DIR/S_fig11.png  right-foot orientation and angular velocity, low-passed at 20 Hz (paper Fig. 11)
   DIR/S_fig12.png  right-foot measured ZMP x and y in the sole frame (paper Fig. 12)
   DIR/S_fig14.png  right-foot linear and angular velocity, low-passed at 20 Hz (paper Fig. 14)

@@ -11,7 +11,7 @@
 // is still an absolute one at 1e-13). Entry-by-entry relative
 // error is meaningless here: MuJoCo re-derives each body inertia from its own principal-axis
 // decomposition, so near-zero entries of M carry absolute noise around 1e-16 x |M|, which is
-// huge relative to themselves (/work/shared/docs/mujoco-2.2-notes.md).
+// huge relative to themselves (docs/simulation.md, MuJoCo 2.2 facts).
 // Tolerance: 1e-11 (tighter than the 1e-9 asked for). The reference model gets its principal
 // inertias from an exact eigen-decomposition of the URDF tensors (urdf_to_mujoco.hpp: MuJoCo's
 // own solver is only good to ~1e-7 relative on tensors with products of inertia), after which

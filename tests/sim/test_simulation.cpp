@@ -480,7 +480,7 @@ namespace {
 
 // Scenario parameters from a YAML file: list values, the file named in errors.
 // ---------------------------------------------------------------------------------------------
-// Moving supports (issue 6): seesaw and skateboards, boards on joints driven by position servos.
+// Moving supports: seesaw and skateboards, boards on joints driven by position servos.
 
 // The target profile against its closed form: zero before the start and after the end, the
 // window's raised-cosine ramps, the full sinusoid in between, and dq the derivative of q.

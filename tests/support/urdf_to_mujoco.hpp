@@ -2,7 +2,7 @@
 // Load a URDF into MuJoCo 2.2.2 as a pure rigid-body model for cross-checks.
 //
 // MuJoCo's URDF defaults do not match a rigid-body-dynamics reading of the file
-// (docs: /work/shared/docs/mujoco-2.2-notes.md), so before compiling we rewrite the text:
+// (docs: docs/simulation.md, MuJoCo 2.2 facts), so before compiling we rewrite the text:
 //  - one <mujoco><compiler .../></mujoco> element: fusestatic="false" keeps every link as a
 //    body with its own name (and mass), inertiafromgeom="false" keeps massless links
 //    massless, balanceinertia="false" keeps the URDF inertias as written;
