@@ -79,6 +79,8 @@ ScenarioParams ablationRunParams(const ScenarioParams& ablation, const std::stri
   p.noise = ablation.noise;
   p.seed = ablation.seed;
   p.substeps = ablation.substeps;
+  p.perturbation = ablation.perturbation;
+  p.run.rules = ablation.run.rules;
   p.friction_compensation = variant.k_f;
   p.friction_model = variant.model;
   p.friction_model_scale = variant.scale;

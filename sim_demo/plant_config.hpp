@@ -41,6 +41,7 @@ struct PlantConfig {
   std::map<std::string, JointPlant> joints;  // by full URDF joint name
   std::array<double, 2> solreffriction{0.02, 1.0};
   std::array<double, 5> solimpfriction{0.9, 0.95, 0.001, 0.5, 2.0};
+  int noslip_iterations = 0;  // MuJoCo's post-pass that removes the soft contacts' tangential creep
   std::string imu_link;
   std::vector<ForceTorqueSite> force_torque;
   SensorNoise noise;
@@ -111,6 +112,14 @@ inline PlantConfig loadPlantConfig(const std::string& path) {
   if (fs) {
     c.solreffriction = plant_detail::numbers<2>(fs["solreffriction"], "friction_solver.solreffriction", path);
     c.solimpfriction = plant_detail::numbers<5>(fs["solimpfriction"], "friction_solver.solimpfriction", path);
+  }
+  const YAML::Node cs = root["contact_solver"];
+  if (cs && cs["noslip_iterations"]) {
+    const double n = number(cs["noslip_iterations"], "contact_solver.noslip_iterations", path);
+    if (!(n >= 0 && n <= 1000) || n != static_cast<int>(n)) {
+      throw std::runtime_error(path + ": 'contact_solver.noslip_iterations' must be an integer in [0, 1000]");
+    }
+    c.noslip_iterations = static_cast<int>(n);
   }
   const YAML::Node sensors = root["sensors"];
   if (!sensors) throw std::runtime_error(path + ": missing map 'sensors'");

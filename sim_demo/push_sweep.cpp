@@ -12,7 +12,11 @@ Eigen::Vector3d unitOf(const std::string& d) {
   if (d == "-x") return -Eigen::Vector3d::UnitX();
   if (d == "+y") return Eigen::Vector3d::UnitY();
   if (d == "-y") return -Eigen::Vector3d::UnitY();
-  throw std::invalid_argument("sweep direction '" + d + "' (expected +x, -x, +y or -y)");
+  // Diagonals: "+x+y" and the like, a unit vector at 45°.
+  if (d.size() == 4 && (d[0] == '+' || d[0] == '-') && d[1] == 'x' && (d[2] == '+' || d[2] == '-') && d[3] == 'y') {
+    return Eigen::Vector3d(d[0] == '+' ? 1.0 : -1.0, d[2] == '+' ? 1.0 : -1.0, 0.0).normalized();
+  }
+  throw std::invalid_argument("sweep direction '" + d + "' (expected +x, -x, +y, -y or a diagonal such as +x-y)");
 }
 
 }  // namespace

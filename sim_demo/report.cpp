@@ -1,5 +1,6 @@
 #include "report.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -110,6 +111,19 @@ nlohmann::ordered_json runRecord(const ScenarioParams& p, const RunSummary& r) {
   }
   j["level_status_counts"] = levels;
   j["safe_mode_ticks"] = r.safe_mode_ticks;
+  j["non_optimal_ticks"] = r.non_optimal_ticks;
+  nlohmann::ordered_json rules = nlohmann::ordered_json::array();
+  for (const RuleResult& x : r.rules) {
+    rules.push_back({{"rule", x.name}, {"value", x.value}, {"threshold", x.threshold}, {"unit", x.unit}, {"passed", x.passed}});
+  }
+  j["rules"] = rules;
+  j["foot_contact"] = nlohmann::ordered_json::array();
+  for (int c = 0; c < kContacts; ++c) {
+    j["foot_contact"].push_back({{"foot", kFoot[c]},
+                                 {"tilt_time_s", r.foot_tilt_time[c]},
+                                 {"max_tilt_deg", r.max_foot_tilt[c] * kDeg},
+                                 {"slide_mm", r.sole_slide[c] * 1e3}});
+  }
   if (r.estimator.available) {
     const auto& a = r.estimator;
     auto stat = [](const ErrorStats& e, double scale) {
@@ -271,6 +285,18 @@ void printRecord(std::FILE* out, const nlohmann::ordered_json& j) {
                  b[0].get<double>(), b[1].get<double>(), b[2].get<double>());
   }
   if (j["safe_mode_ticks"].get<long>() > 0) std::fprintf(out, "  safe-mode ticks    : %ld\n", j["safe_mode_ticks"].get<long>());
+  for (const auto& f : j["foot_contact"]) {
+    std::fprintf(out, "  %-5s sole contact  : max tilt %.2f deg to its support, %.3f s tilted, slide %.1f mm\n",
+                 f["foot"].get<std::string>().c_str(), f["max_tilt_deg"].get<double>(), f["tilt_time_s"].get<double>(),
+                 f["slide_mm"].get<double>());
+  }
+  std::fprintf(out, "  pass rules         :");
+  for (const auto& x : j["rules"]) {
+    std::fprintf(out, " %s %s %.4g%s%s (<= %.4g);", x["passed"].get<bool>() ? "ok" : "FAILED",
+                 x["rule"].get<std::string>().c_str(), x["value"].get<double>(), x["unit"].get<std::string>().empty() ? "" : " ",
+                 x["unit"].get<std::string>().c_str(), x["threshold"].get<double>());
+  }
+  std::fprintf(out, "\n");
   if (j["feet_touch_s"].get<double>() > 0) std::fprintf(out, "  feet touching      : %.3f s\n", j["feet_touch_s"].get<double>());
   for (const char* k : {"csv", "video"}) {
     const std::string f = j["files"][k].get<std::string>();
@@ -282,8 +308,9 @@ void printRecord(std::FILE* out, const nlohmann::ordered_json& j) {
 std::string markdownTable(const std::vector<nlohmann::ordered_json>& records) {
   std::ostringstream s;
   s << "| scenario | controller | result | max torso pitch (°) | max torso roll (°) | CoM x (mm) | "
-       "max right-foot pitch (°) | min ZMP margin (mm) | lowest-level error max | tick mean / p99.9 / max (µs) | RTF |\n"
-    << "|---|---|---|---|---|---|---|---|---|---|---|\n";
+       "max right-foot pitch (°) | min ZMP margin (mm) | sole slide (mm) / tilted (s) | lowest-level error max | "
+       "tick mean / p99.9 / max (µs) | RTF |\n"
+    << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   bool push_x = false;
   for (const auto& j : records) {
     if (j.contains("directions") || j.contains("ablation")) continue;  // their own tables
@@ -291,18 +318,27 @@ std::string markdownTable(const std::vector<nlohmann::ordered_json>& records) {
     std::string result = j["passed"].get<bool>() ? "PASS" : "FAIL";
     if (j["fell"].get<bool>()) result += fmt(" (fell at %.2f s: ", j["fall_time"].get<double>()) + j["fall_reason"].get<std::string>() + ")";
     else if (!j["zmp_inside"].get<bool>()) result += " (ZMP left a sole)";
-    else if (j["safe_mode_ticks"].get<long>() > 0) result += " (safe mode)";
+    else {
+      std::string failed;
+      for (const auto& x : j["rules"]) {
+        if (!x["passed"].get<bool>()) failed += (failed.empty() ? "" : ", ") + x["rule"].get<std::string>();
+      }
+      if (!failed.empty()) result += " (" + failed + ")";
+    }
     s << "| " << j["scenario"].get<std::string>() << " | " << j["controller"].get<std::string>() << " | " << result
       << " | " << fmt("%.1f", j["max_torso_pitch_deg"].get<double>()) << " | "
       << fmt("%.1f", j["max_torso_roll_deg"].get<double>()) << " | " << fmt("%+.0f", j["com_x_min_mm"].get<double>())
       << " … " << fmt("%+.0f", j["com_x_max_mm"].get<double>()) << " | "
       << fmt("%.2f", j["max_foot_pitch_deg"].get<double>()) << " | " << fmtOr(j["zmp_margin_mm"], "%.1f") << " | "
-      << fmt("%.3g", j["lowest_level_error_max"].get<double>()) << " | " << fmt("%.0f", j["tick_mean_us"].get<double>())
+      << fmt("%.1f", std::max(j["foot_contact"][0]["slide_mm"].get<double>(), j["foot_contact"][1]["slide_mm"].get<double>()))
+      << " / "
+      << fmt("%.2f", std::max(j["foot_contact"][0]["tilt_time_s"].get<double>(), j["foot_contact"][1]["tilt_time_s"].get<double>()))
+      << " | " << fmt("%.3g", j["lowest_level_error_max"].get<double>()) << " | " << fmt("%.0f", j["tick_mean_us"].get<double>())
       << " / " << fmt("%.0f", j["tick_p999_us"].get<double>()) << " / " << fmt("%.0f", j["tick_max_us"].get<double>())
       << " | " << fmt("%.1f", j["real_time_factor"].get<double>()) << " |\n";
   }
   if (push_x) {
-    s << "| *paper, push_x (Table II, Fig. 8)* | HQP | survived 12 N·s | 25.7 | – | −29 … +56 | 1.5 | – | ~10³ peaks | 363 (loop mean) | – |\n";
+    s << "| *paper, push_x (Table II, Fig. 8)* | HQP | survived 12 N·s | 25.7 | – | −29 … +56 | 1.5 | – | – | ~10³ peaks | 363 (loop mean) | – |\n";
   }
   // Moving supports: what the right foot went through (MuJoCo ground truth, 20 Hz low-pass).
   bool header = false;

@@ -55,6 +55,7 @@ class CsvLog {
     for (const SupportMotion& m : supports) std::fprintf(f_, ",support_%s", m.axis.c_str());
     std::fprintf(f_, "%s", driver_.logHeader().c_str());
     for (int i = 0; i < kJoints; ++i) std::fprintf(f_, ",tau_err_%s", Robot::bodies[i + 1].joint);
+    std::fprintf(f_, ",l_sole_slide,r_sole_slide,l_sole_tilt,r_sole_tilt");
     std::fputc('\n', f_);
   }
   ~CsvLog() { std::fclose(f_); }
@@ -88,9 +89,12 @@ class CsvLog {
     for (int a : support_actuators) std::fprintf(f_, ",%.6f", sim.supportPosition(a));
     driver_.logRow(f_);
   }
-  // The row's last columns, known only after the step: τ_opt − delivered torque (NaN: no τ_opt).
-  void endRow(const VectorJ& tau_err) {
+  // The row's last columns, known only after the step: τ_opt − delivered torque (NaN: no τ_opt),
+  // each sole's slide on its support since loaded (m) and tilt to it (rad) (NaN: unloaded).
+  void endRow(const VectorJ& tau_err, const std::array<double, kContacts>& slide,
+              const std::array<double, kContacts>& tilt) {
     for (int i = 0; i < kJoints; ++i) std::fprintf(f_, ",%.4f", tau_err[i]);
+    std::fprintf(f_, ",%.6f,%.6f,%.6f,%.6f", slide[0], slide[1], tilt[0], tilt[1]);
     std::fputc('\n', f_);
   }
 
@@ -165,6 +169,9 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
   EstimateSample est;
   Eigen::Vector3d est_p0 = Eigen::Vector3d::Zero(), est_com0 = Eigen::Vector3d::Zero();
   bool est_started = false;
+  // Contact quality (PassRules): the body each loaded sole stands on and where it was loaded.
+  std::array<int, kContacts> anchor_body{-1, -1};
+  std::array<Eigen::Vector2d, kContacts> anchor;
   for (long k = 0; k < ticks; ++k) {
     sim.readSensors(s);
     const auto t0 = std::chrono::steady_clock::now();
@@ -243,6 +250,12 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
         const int st = solver.level_status[l];
         if (st >= 0 && st < RunSummary::kStatuses) ++r.level_status_counts[l][st];
       }
+      for (int l = 0; l < r.num_levels; ++l) {
+        if (solver.level_status[l] != 0) {  // QpStatus::Optimal
+          ++r.non_optimal_ticks;
+          break;
+        }
+      }
       if (r.num_levels > 0) {
         const double e = solver.level_residual[r.num_levels - 1];
         r.lowest_level_error_max = std::max(r.lowest_level_error_max, e);
@@ -284,7 +297,6 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
       r.torque_tracking_max = std::max(r.torque_tracking_max, tau_err.cwiseAbs().maxCoeff());
       ++tau_ticks;
     }
-    if (log) log->endRow(tau_err);
     if (ball_state > 0) {
       const bool touching = sim.ballTouchesRobot();
       if (ball_state == 1 && touching) ball_state = 2;
@@ -295,6 +307,29 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
     }
 
     if (sim.feetTouch()) ++r.feet_touch_ticks;
+    std::array<double, kContacts> slide_now, tilt_now;
+    slide_now.fill(std::numeric_limits<double>::quiet_NaN());
+    tilt_now.fill(std::numeric_limits<double>::quiet_NaN());
+    for (int c = 0; c < kContacts; ++c) {
+      const int b = sim.soleSupport(c);
+      if (b < 0 || !(sim.wrenchInSole(c, sim.trueForceTorque(c))[2] >= o.zmp_min_fz)) {
+        anchor_body[c] = -1;  // unloaded: a new slide starts where it lands again
+        continue;
+      }
+      const Eigen::Isometry3d T = sim.soleInBody(c, b);
+      const double tilt = std::acos(std::clamp(T.linear()(2, 2), -1.0, 1.0));  // between the z axes
+      r.max_foot_tilt[c] = std::max(r.max_foot_tilt[c], tilt);
+      if (tilt > o.rules.foot_tilt_angle) r.foot_tilt_time[c] += sim.controlDt();
+      const Eigen::Vector2d p = T.translation().head<2>();  // in the support's plane
+      if (anchor_body[c] != b) {
+        anchor_body[c] = b;
+        anchor[c] = p;
+      }
+      slide_now[c] = (p - anchor[c]).norm();
+      tilt_now[c] = tilt;
+      r.sole_slide[c] = std::max(r.sole_slide[c], slide_now[c]);
+    }
+    if (log) log->endRow(tau_err, slide_now, tilt_now);
     const Eigen::Vector3d com_d = sim.centerOfMass() - com0;
     r.com_x_min = std::min(r.com_x_min, com_d.x());
     r.com_x_max = std::max(r.com_x_max, com_d.x());
@@ -351,7 +386,16 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
     r.torque_tracking_rms = r.torque_tracking_max = r.torque_tracking_link_rms = std::numeric_limits<double>::quiet_NaN();
     r.torque_tracking_rms_joint.setConstant(std::numeric_limits<double>::quiet_NaN());
   }
-  r.passed = !r.fell && r.safe_mode_ticks == 0 && r.zmp_inside;
+  auto rule = [&](const char* name, double value, double threshold, const char* unit) {
+    r.rules.push_back({name, value, threshold, unit, value <= threshold});
+  };
+  rule("foot_tilt_time", std::max(r.foot_tilt_time[0], r.foot_tilt_time[1]), o.rules.foot_tilt_time, "s");
+  rule("sole_slide", std::max(r.sole_slide[0], r.sole_slide[1]), o.rules.sole_slide, "m");
+  rule("feet_touch_time", r.feet_touch_ticks * sim.controlDt(), o.rules.feet_touch_time, "s");
+  rule("non_optimal_ticks", static_cast<double>(r.non_optimal_ticks), static_cast<double>(o.rules.non_optimal_ticks), "");
+  rule("safe_mode_ticks", static_cast<double>(r.safe_mode_ticks), static_cast<double>(o.rules.safe_mode_ticks), "");
+  r.passed = !r.fell && r.zmp_inside;
+  for (const RuleResult& x : r.rules) r.passed = r.passed && x.passed;
   // The real-time factor of the loop itself, without video rendering (which is offline work).
   r.real_time_factor = r.duration / std::max(1e-9, r.wall_time - video_s);
   if (!tick_us.empty()) {

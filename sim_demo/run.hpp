@@ -117,6 +117,25 @@ struct Push {
   bool ball = false;
 };
 
+// Pass rules beyond "no fall, ZMP inside the soles" (docs/scenarios.md, "Pass rules"): each is a
+// named metric measured on every run, with the threshold that fails it.
+struct PassRules {
+  double foot_tilt_angle = 2.0 * M_PI / 180.0;  // rad: a loaded sole tilted more than this from its support is tilted
+  double foot_tilt_time = 0.05;                  // s per foot of tilted time that fails the run
+  double sole_slide = 0.005;                     // m: a loaded sole moved further than this on its support fails
+  double feet_touch_time = 0.0;                  // s the two soles may touch each other
+  long non_optimal_ticks = 0;                    // ticks with any hierarchy level not Optimal
+  long safe_mode_ticks = 0;                      // ticks in the controller's safe mode
+};
+
+// One rule's outcome in a run.
+struct RuleResult {
+  std::string name;  // foot_tilt_time, sole_slide, feet_touch_time, non_optimal_ticks, safe_mode_ticks
+  double value = 0, threshold = 0;
+  const char* unit = "";
+  bool passed = true;
+};
+
 struct RunOptions {
   std::string scenario = "stand";
   double duration = 10.0;          // s
@@ -137,6 +156,7 @@ struct RunOptions {
   // (supportTarget at the current time); the scene must have the named actuators.
   std::vector<SupportMotion> supports;
   double foot_velocity_cutoff = 20.0;  // Hz, low-pass of the foot velocity peaks (the paper's Fig. 11)
+  PassRules rules;
 };
 
 struct RunSummary {
@@ -186,7 +206,14 @@ struct RunSummary {
   std::array<Eigen::Vector3d, kContacts> foot_angular_velocity_peak, foot_linear_velocity_peak;
   std::array<double, kContacts> max_abs_foot_yaw{};
   EstimatorAccuracy estimator;  // base_position/com (m), velocities (m/s), orientation (rad)
-  bool passed = false;  // no fall, no safe mode, every loaded ZMP inside its sole (+ tolerance)
+  // Contact quality of each loaded foot (f_z >= zmp_min_fz) relative to the body it stands on
+  // (floor, seesaw, board): time tilted beyond PassRules::foot_tilt_angle, largest tilt, and the
+  // largest distance the sole origin moved on that body since it was loaded (m).
+  std::array<double, kContacts> foot_tilt_time{}, max_foot_tilt{}, sole_slide{};
+  long non_optimal_ticks = 0;  // ticks with any level's status other than Optimal
+  std::vector<RuleResult> rules;
+  // No fall, every loaded ZMP inside its sole (+ tolerance), and every rule passed.
+  bool passed = false;
   std::string csv_path, video_path;
 };
 

@@ -141,6 +141,43 @@ std::string join(const std::vector<std::string>& items) {
   return s;
 }
 
+// "none" or "NAME:VALUE,..." (link or joint names with a factor or error).
+std::vector<std::pair<std::string, double>> parseNamedList(const std::string& key, const std::string& v, double lo,
+                                                           double hi) {
+  std::vector<std::pair<std::string, double>> out;
+  if (v == "none" || v.empty()) return out;
+  for (const std::string& item : split(v, ',')) {
+    const std::vector<std::string> f = split(item, ':');
+    if (f.size() != 2 || f[0].empty()) badValue(key, v, "none or NAME:VALUE items separated by commas, e.g. torso:1.1");
+    out.emplace_back(f[0], parseDouble(key, f[1], lo, hi));
+  }
+  return out;
+}
+
+std::string formatNamedList(const std::vector<std::pair<std::string, double>>& list) {
+  if (list.empty()) return "none";
+  std::string s;
+  for (const auto& [name, x] : list) s += (s.empty() ? "" : ",") + name + ":" + formatDouble(x);
+  return s;
+}
+
+// "0" or "FX:FY:FZ:MX:MY:MZ" (N, N·m, sensor frame).
+Vector6 parseWrench(const std::string& key, const std::string& v) {
+  if (v == "0" || v == "none") return Vector6::Zero();
+  const std::vector<std::string> f = split(v, ':');
+  if (f.size() != 6) badValue(key, v, "0 or FX:FY:FZ:MX:MY:MZ (N, N·m)");
+  Vector6 w;
+  for (int i = 0; i < 6; ++i) w[i] = parseDouble(key, f[static_cast<std::size_t>(i)], -1000.0, 1000.0);
+  return w;
+}
+
+std::string formatWrench(const Vector6& w) {
+  if (w.isZero()) return "0";
+  std::string s;
+  for (int i = 0; i < 6; ++i) s += (i ? ":" : "") + formatDouble(w[i]);
+  return s;
+}
+
 struct Parameter {
   std::string key;
   const char* help;
@@ -201,13 +238,14 @@ const std::vector<Parameter>& parameters() {
       {"video_fps", "video frame rate",
        [](P& p, S k, S v) { p.run.video_fps = static_cast<int>(parseInt(k, v, 1, 120)); },
        [](const P& p) { return std::to_string(p.run.video_fps); }},
-      {"sweep_directions", "push_sweep: directions among +x,-x,+y,-y; skate_sweep: axes among x,y,z,roll,pitch,yaw",
+      {"sweep_directions", "push_sweep: directions among +x,-x,+y,-y and the diagonals +x+y,+x-y,-x+y,-x-y; skate_sweep: axes among x,y,z,roll,pitch,yaw",
        [](P& p, S k, S v) {
-         const char* expected = "a list of +x, -x, +y, -y (push_sweep) or x, y, z, roll, pitch, yaw (skate_sweep)";
+         const char* expected = "a list of +x, -x, +y, -y, +x+y, +x-y, -x+y, -x-y (push_sweep) or x, y, z, roll, pitch, yaw (skate_sweep)";
          std::vector<std::string> d = split(v, ',');
          if (d.empty()) badValue(k, v, expected);
          for (const std::string& s : d) {
-           const bool push = s == "+x" || s == "-x" || s == "+y" || s == "-y";
+           const bool push = s == "+x" || s == "-x" || s == "+y" || s == "-y" || s == "+x+y" || s == "+x-y" ||
+                             s == "-x+y" || s == "-x-y";
            const bool skate = s == "x" || s == "y" || s == "z" || s == "roll" || s == "pitch" || s == "yaw";
            if (!(push || skate)) badValue(k, v, expected);
          }
@@ -292,6 +330,97 @@ const std::vector<Parameter>& parameters() {
          for (SupportMotion& m : p.supports) m.ramp = p.support_ramp;
        },
        [](const P& p) { return formatDouble(p.support_ramp); }},
+      // Plant perturbations (plant only; docs/scenarios.md, "Plant perturbations").
+      {"payload", "plant: none or LINK:MASS:X:Y:Z, a point mass (kg) at (m) in the link's frame",
+       [](P& p, S k, S v) {
+         PlantPerturbation& pp = p.perturbation;
+         if (v == "none" || v.empty()) {
+           pp.payload_link.clear();
+           pp.payload_mass = 0.0;
+           pp.payload_position.setZero();
+           return;
+         }
+         const std::vector<std::string> f = split(v, ':');
+         if (f.size() != 5 || f[0].empty()) badValue(k, v, "none or LINK:MASS:X:Y:Z, e.g. torso:5:0:0:0.3");
+         pp.payload_link = f[0];
+         pp.payload_mass = parseDouble(k, f[1], 1e-6, 1000.0);
+         for (int i = 0; i < 3; ++i) pp.payload_position[i] = parseDouble(k, f[static_cast<std::size_t>(2 + i)], -2.0, 2.0);
+       },
+       [](const P& p) {
+         const PlantPerturbation& pp = p.perturbation;
+         if (pp.payload_link.empty()) return std::string("none");
+         return pp.payload_link + ":" + formatDouble(pp.payload_mass) + ":" + formatDouble(pp.payload_position.x()) + ":" +
+                formatDouble(pp.payload_position.y()) + ":" + formatDouble(pp.payload_position.z());
+       }},
+      {"mass_scale", "plant: factor on the mass and inertia of every robot link",
+       [](P& p, S k, S v) { p.perturbation.mass_scale = parseDouble(k, v, 0.1, 10.0); },
+       [](const P& p) { return formatDouble(p.perturbation.mass_scale); }},
+      {"link_mass_scale", "plant: none or LINK:FACTOR,... on the mass and inertia of single links (e.g. torso:1.1)",
+       [](P& p, S k, S v) { p.perturbation.link_mass_scale = parseNamedList(k, v, 0.1, 10.0); },
+       [](const P& p) { return formatNamedList(p.perturbation.link_mass_scale); }},
+      {"sensor_latency", "plant: encoder, IMU and F/T latency at once, ticks (reads the encoder value)",
+       [](P& p, S k, S v) {
+         const int n = static_cast<int>(parseInt(k, v, 0, 100));
+         p.perturbation.encoder_latency = p.perturbation.imu_latency = p.perturbation.ft_latency = n;
+       },
+       [](const P& p) { return std::to_string(p.perturbation.encoder_latency); }},
+      {"encoder_latency", "plant: joint encoder latency, ticks",
+       [](P& p, S k, S v) { p.perturbation.encoder_latency = static_cast<int>(parseInt(k, v, 0, 100)); },
+       [](const P& p) { return std::to_string(p.perturbation.encoder_latency); }},
+      {"imu_latency", "plant: IMU latency, ticks",
+       [](P& p, S k, S v) { p.perturbation.imu_latency = static_cast<int>(parseInt(k, v, 0, 100)); },
+       [](const P& p) { return std::to_string(p.perturbation.imu_latency); }},
+      {"ft_latency", "plant: F/T sensor latency, ticks",
+       [](P& p, S k, S v) { p.perturbation.ft_latency = static_cast<int>(parseInt(k, v, 0, 100)); },
+       [](const P& p) { return std::to_string(p.perturbation.ft_latency); }},
+      {"actuator_latency", "plant: motors apply the current commanded this many ticks ago",
+       [](P& p, S k, S v) { p.perturbation.actuator_latency = static_cast<int>(parseInt(k, v, 0, 100)); },
+       [](const P& p) { return std::to_string(p.perturbation.actuator_latency); }},
+      {"ft_offset_left", "plant: 0 or FX:FY:FZ:MX:MY:MZ added to the left F/T reading (N, N·m, sensor frame)",
+       [](P& p, S k, S v) { p.perturbation.ft_offset[0] = parseWrench(k, v); },
+       [](const P& p) { return formatWrench(p.perturbation.ft_offset[0]); }},
+      {"ft_offset_right", "plant: 0 or FX:FY:FZ:MX:MY:MZ added to the right F/T reading",
+       [](P& p, S k, S v) { p.perturbation.ft_offset[1] = parseWrench(k, v); },
+       [](const P& p) { return formatWrench(p.perturbation.ft_offset[1]); }},
+      {"torque_constant_error", "plant: relative error of every motor's torque constant (0.1: 10 % stronger than modelled)",
+       [](P& p, S k, S v) { p.perturbation.torque_constant_error = parseDouble(k, v, -0.9, 10.0); },
+       [](const P& p) { return formatDouble(p.perturbation.torque_constant_error); }},
+      {"torque_constant_error_joint", "plant: none or JOINT:ERROR,... per joint, on top (e.g. l_knee:-0.2)",
+       [](P& p, S k, S v) { p.perturbation.torque_constant_error_joint = parseNamedList(k, v, -0.9, 10.0); },
+       [](const P& p) { return formatNamedList(p.perturbation.torque_constant_error_joint); }},
+      {"joint_friction_scale", "plant: factor on the joints' Coulomb and viscous friction (the controller's model keeps its own)",
+       [](P& p, S k, S v) { p.perturbation.joint_friction_scale = parseDouble(k, v, 0.0, 10.0); },
+       [](const P& p) { return formatDouble(p.perturbation.joint_friction_scale); }},
+      {"ground_friction", "plant: sliding friction coefficient of every contact, or scene (the scene's, 1)",
+       [](P& p, S k, S v) { p.perturbation.ground_friction = v == "scene" ? -1.0 : parseDouble(k, v, 0.0, 5.0); },
+       [](const P& p) {
+         return p.perturbation.ground_friction < 0 ? std::string("scene") : formatDouble(p.perturbation.ground_friction);
+       }},
+      {"contact", "plant: contact softness preset, default (the scene's), soft or hard",
+       [](P& p, S k, S v) {
+         if (v != "default" && v != "soft" && v != "hard") badValue(k, v, "default, soft or hard");
+         p.perturbation.contact = v;
+       },
+       [](const P& p) { return p.perturbation.contact; }},
+      // Pass rules (docs/scenarios.md, "Pass rules").
+      {"rule_foot_tilt_angle", "pass rule: a loaded sole tilted more than this from its support counts as tilted, deg",
+       [](P& p, S k, S v) { p.run.rules.foot_tilt_angle = parseDouble(k, v, 0.0, 90.0) * M_PI / 180.0; },
+       [](const P& p) { return formatDouble(p.run.rules.foot_tilt_angle * 180.0 / M_PI); }},
+      {"rule_foot_tilt_time", "pass rule: tilted time per foot that fails the run, s",
+       [](P& p, S k, S v) { p.run.rules.foot_tilt_time = parseDouble(k, v, 0.0, 3600.0); },
+       [](const P& p) { return formatDouble(p.run.rules.foot_tilt_time); }},
+      {"rule_sole_slide", "pass rule: a loaded sole moving further than this on its support fails the run, m",
+       [](P& p, S k, S v) { p.run.rules.sole_slide = parseDouble(k, v, 0.0, 10.0); },
+       [](const P& p) { return formatDouble(p.run.rules.sole_slide); }},
+      {"rule_feet_touch_time", "pass rule: time the two soles may touch each other, s",
+       [](P& p, S k, S v) { p.run.rules.feet_touch_time = parseDouble(k, v, 0.0, 3600.0); },
+       [](const P& p) { return formatDouble(p.run.rules.feet_touch_time); }},
+      {"rule_non_optimal_ticks", "pass rule: ticks with a hierarchy level not Optimal that the run may have",
+       [](P& p, S k, S v) { p.run.rules.non_optimal_ticks = parseInt(k, v, 0, 100000000); },
+       [](const P& p) { return std::to_string(p.run.rules.non_optimal_ticks); }},
+      {"rule_safe_mode_ticks", "pass rule: ticks in the controller's safe mode that the run may have",
+       [](P& p, S k, S v) { p.run.rules.safe_mode_ticks = parseInt(k, v, 0, 100000000); },
+       [](const P& p) { return std::to_string(p.run.rules.safe_mode_ticks); }},
   };
   static const std::vector<Parameter> with_motions = [] {
     std::vector<Parameter> t = table;

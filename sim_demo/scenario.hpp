@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "plant_perturbation.hpp"
 #include "run.hpp"
 #include "support_motion.hpp"
 
@@ -51,6 +52,7 @@ struct ScenarioParams {
   double friction_model_scale = 1.0;      // factor on those F_c and F_v
   double kinematic_compensation = 1.0;    // factor on the YAML's k_q̇ (eq. 8)
   std::string estimator = "config";       // config (controller YAML's), stance or kinematic_inertial
+  PlantPerturbation perturbation;         // the plant's differences from the controller's model
   bool ablation = false;                  // friction_ablation: runs instead of one run
   AblationParams ablation_params;
   // Moving supports: the scene file (in the directory of the default scene.xml) and

@@ -92,6 +92,7 @@ hqp::sim::SimulationOptions simulationOptions(const Paths& paths, const Scenario
   so.noise = p.noise;
   so.seed = p.seed;
   so.substeps = p.substeps;
+  so.perturbation = p.perturbation;
   return so;
 }
 

@@ -1,5 +1,7 @@
 #include "simulation.hpp"
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -28,6 +30,7 @@ Simulation::Simulation(const SimulationOptions& options) : options_(options), rn
   m_ = mj_loadXML(options_.scene.c_str(), nullptr, error, sizeof(error));
   if (!m_) throw std::runtime_error("cannot load scene " + options_.scene + ": " + error);
   m_->opt.timestep = options_.control_dt / options_.substeps;
+  m_->opt.noslip_iterations = plant_.noslip_iterations;
   d_ = mj_makeData(m_);
 
   for (int i = 0; i < kJoints; ++i) {
@@ -87,7 +90,95 @@ Simulation::Simulation(const SimulationOptions& options) : options_(options), rn
     const Eigen::Vector2d half(m_->geom_size[3 * plate], m_->geom_size[3 * plate + 1]);
     sole_rect_[c] = {centre - half, centre + half};
   }
+  applyModelPerturbation();
   reset();
+}
+
+void Simulation::applyModelPerturbation() {
+  const PlantPerturbation& pp = options_.perturbation;
+  auto bodyOf = [&](const std::string& name) {
+    const int b = mj_name2id(m_, mjOBJ_BODY, name.c_str());
+    if (b < 0 || m_->body_rootid[b] != torso_) {
+      throw std::runtime_error("plant perturbation: the robot has no body '" + name + "'");
+    }
+    return b;
+  };
+  auto scaleMass = [&](int b, double f) {
+    if (!(f > 0.0)) throw std::runtime_error("plant perturbation: mass scale must be > 0");
+    m_->body_mass[b] *= f;
+    for (int k = 0; k < 3; ++k) m_->body_inertia[3 * b + k] *= f;
+  };
+  if (pp.mass_scale != 1.0) {
+    for (int b = 1; b < m_->nbody; ++b) {
+      if (m_->body_rootid[b] == torso_) scaleMass(b, pp.mass_scale);
+    }
+  }
+  for (const auto& [name, f] : pp.link_mass_scale) scaleMass(bodyOf(name), f);
+  if (!pp.payload_link.empty() && pp.payload_mass != 0.0) {
+    // A point mass at p (body frame): new CoM and the inertia about it by the parallel-axis
+    // theorem, then back to MuJoCo's principal form (body_inertia, body_iquat).
+    const int b = bodyOf(pp.payload_link);
+    const double m = m_->body_mass[b], mp = pp.payload_mass, mt = m + mp;
+    if (!(mp > 0.0)) throw std::runtime_error("plant perturbation: payload mass must be > 0");
+    const Eigen::Vector3d c(m_->body_ipos + 3 * b), p = pp.payload_position;
+    const Eigen::Vector3d ct = (m * c + mp * p) / mt;
+    const double* iq = m_->body_iquat + 4 * b;
+    const Eigen::Matrix3d R = Eigen::Quaterniond(iq[0], iq[1], iq[2], iq[3]).normalized().toRotationMatrix();
+    const Eigen::Vector3d I0(m_->body_inertia + 3 * b);
+    auto shift = [](double mass, const Eigen::Vector3d& r) {
+      return (mass * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose())).eval();
+    };
+    const Eigen::Matrix3d I = R * I0.asDiagonal() * R.transpose() + shift(m, c - ct) + shift(mp, p - ct);
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(I);
+    Eigen::Matrix3d V = eig.eigenvectors();
+    if (V.determinant() < 0) V.col(0) = -V.col(0);
+    const Eigen::Quaterniond q(V);
+    m_->body_mass[b] = mt;
+    for (int k = 0; k < 3; ++k) {
+      m_->body_ipos[3 * b + k] = ct[k];
+      m_->body_inertia[3 * b + k] = eig.eigenvalues()[k];
+    }
+    m_->body_iquat[4 * b] = q.w();
+    m_->body_iquat[4 * b + 1] = q.x();
+    m_->body_iquat[4 * b + 2] = q.y();
+    m_->body_iquat[4 * b + 3] = q.z();
+  }
+  if (pp.joint_friction_scale != 1.0) {
+    if (!(pp.joint_friction_scale >= 0.0)) throw std::runtime_error("plant perturbation: friction scale must be >= 0");
+    for (int i = 0; i < kJoints; ++i) {
+      m_->dof_frictionloss[dofadr_[i]] *= pp.joint_friction_scale;
+      m_->dof_damping[dofadr_[i]] *= pp.joint_friction_scale;
+    }
+  }
+  // Every geom alike: MuJoCo combines two geoms' friction by the maximum and their solref and
+  // solimp by a mixture, so equal values give exactly these.
+  if (pp.ground_friction >= 0.0) {
+    for (int g = 0; g < m_->ngeom; ++g) m_->geom_friction[3 * g] = pp.ground_friction;
+  }
+  if (pp.contact != "default") {
+    const ContactPreset c = contactPreset(pp.contact);
+    for (int g = 0; g < m_->ngeom; ++g) {
+      for (int k = 0; k < 2; ++k) m_->geom_solref[mjNREF * g + k] = c.solref[k];
+      for (int k = 0; k < 5; ++k) m_->geom_solimp[mjNIMP * g + k] = c.solimp[k];
+    }
+  }
+  k_t_plant_ = k_t_ * (1.0 + pp.torque_constant_error);
+  for (const auto& [name, e] : pp.torque_constant_error_joint) {
+    int found = -1;
+    for (int i = 0; i < kJoints; ++i) {
+      if (name == Robot::bodies[i + 1].joint) found = i;
+    }
+    if (found < 0) throw std::runtime_error("plant perturbation: the robot has no joint '" + name + "'");
+    k_t_plant_[found] *= 1.0 + e;
+  }
+  if (!(k_t_plant_.minCoeff() > 0.0)) throw std::runtime_error("plant perturbation: a torque constant became <= 0");
+  if (pp.encoder_latency < 0 || pp.imu_latency < 0 || pp.ft_latency < 0 || pp.actuator_latency < 0) {
+    throw std::runtime_error("plant perturbation: latency must be >= 0 ticks");
+  }
+  sensor_history_.assign(static_cast<std::size_t>(pp.maxSensorLatency() + 1), Sensors{});
+  current_history_.assign(static_cast<std::size_t>(pp.actuator_latency + 1), VectorJ::Zero());
+  // Derived constants (subtree masses, the constraint solver's inverse weights) of the new model.
+  if (pp.any()) mj_setConst(m_, d_);
 }
 
 Simulation::~Simulation() {
@@ -125,6 +216,9 @@ void Simulation::reset() {
   base[2] -= drop;
   for (int u = 0; u < m_->nu; ++u) d_->ctrl[u] = 0.0;
   ball_flying_ = false;  // mj_resetData parked the ball at its qpos0
+  sensor_head_ = sensor_count_ = 0;
+  for (VectorJ& c : current_history_) c.setZero();
+  current_head_ = 0;
   delivered_.setZero();
   gyro_bias_.setZero();
   accel_bias_.setZero();
@@ -191,7 +285,29 @@ void Simulation::readSensors(Sensors& s) {
     // contact balances exactly: the support's wrench on the foot is its negative.
     s.ft[c] = trueForceTorque(c);
   }
-  if (!options_.noise) return;
+  if (options_.noise) addNoise(s);
+  const PlantPerturbation& pp = options_.perturbation;
+  for (int c = 0; c < kContacts; ++c) s.ft[c] += pp.ft_offset[c];
+  if (sensor_history_.size() > 1) {
+    // Newest reading into the ring, then each group from its own age (the oldest available at the start).
+    const int n = static_cast<int>(sensor_history_.size());
+    sensor_head_ = (sensor_head_ + 1) % n;
+    sensor_history_[sensor_head_] = s;
+    sensor_count_ = std::min(sensor_count_ + 1, n);
+    auto aged = [&](int latency) -> const Sensors& {
+      return sensor_history_[(sensor_head_ - std::min(latency, sensor_count_ - 1) + n) % n];
+    };
+    const Sensors &enc = aged(pp.encoder_latency), &imu = aged(pp.imu_latency), &ft = aged(pp.ft_latency);
+    s.q = enc.q;
+    s.dq = enc.dq;
+    s.imu_orientation = imu.imu_orientation;
+    s.imu_gyro = imu.imu_gyro;
+    s.imu_accel = imu.imu_accel;
+    s.ft = ft.ft;
+  }
+}
+
+void Simulation::addNoise(Sensors& s) {
   const SensorNoise& n = plant_.noise;
   std::normal_distribution<double> g(0.0, 1.0);
   for (int i = 0; i < kJoints; ++i) {
@@ -220,9 +336,13 @@ void Simulation::readSensors(Sensors& s) {
 }
 
 void Simulation::applyCommand(const Command& c) {
+  const int n = static_cast<int>(current_history_.size());
+  current_head_ = (current_head_ + 1) % n;
+  current_history_[current_head_] = c.current;
+  const VectorJ& current = current_history_[(current_head_ + 1) % n];  // n - 1 calls ago (zero at first)
   for (int i = 0; i < kJoints; ++i) {
-    const double current = std::isfinite(c.current[i]) ? c.current[i] : 0.0;
-    d_->ctrl[act_[i]] = k_t_[i] * current;  // MuJoCo clamps to ctrlrange
+    const double a = std::isfinite(current[i]) ? current[i] : 0.0;
+    d_->ctrl[act_[i]] = k_t_plant_[i] * a;  // MuJoCo clamps to ctrlrange
   }
 }
 
@@ -362,6 +482,33 @@ bool Simulation::feetTouch() const {
     if ((b1 == sole_body_[0] && b2 == sole_body_[1]) || (b1 == sole_body_[1] && b2 == sole_body_[0])) return true;
   }
   return false;
+}
+
+int Simulation::soleSupport(int c) const {
+  for (int i = 0; i < d_->ncon; ++i) {
+    const int b1 = m_->geom_bodyid[d_->contact[i].geom1], b2 = m_->geom_bodyid[d_->contact[i].geom2];
+    if (b1 == sole_body_[c] && b2 != sole_body_[1 - c]) return b2;
+    if (b2 == sole_body_[c] && b1 != sole_body_[1 - c]) return b1;
+  }
+  return -1;
+}
+
+namespace {
+
+Eigen::Isometry3d bodyPose(const mjData* d, int b) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  const double* R = d->xmat + 9 * b;  // row-major
+  for (int r = 0; r < 3; ++r) {
+    for (int k = 0; k < 3; ++k) T.linear()(r, k) = R[3 * r + k];
+  }
+  T.translation() = Eigen::Vector3d(d->xpos + 3 * b);
+  return T;
+}
+
+}  // namespace
+
+Eigen::Isometry3d Simulation::soleInBody(int c, int b) const {
+  return bodyPose(d_, b).inverse() * bodyPose(d_, sole_body_[c]);
 }
 
 Vector6 Simulation::trueForceTorque(int c) const {

@@ -14,6 +14,7 @@
 #include <string>
 
 #include "plant_config.hpp"
+#include "plant_perturbation.hpp"
 #include "tasks/sensor_data.hpp"
 #include "walker3_model.hpp"
 
@@ -35,6 +36,7 @@ struct SimulationOptions {
   bool noise = false;              // add the plant file's Gaussian sensor noise
   unsigned seed = 1;               // noise seed
   double hip_pitch = -0.3, knee = 0.6, ankle_pitch = -0.3;  // standing pose (rad), both legs
+  PlantPerturbation perturbation;  // the plant's differences from the controller's model (off)
 };
 
 class Simulation {
@@ -47,11 +49,13 @@ class Simulation {
   // Standing pose, torso upright, at rest, t = 0, zero command; the soles rest on whatever is
   // below them (floor, seesaw, skateboards: found by a ray straight down from each sole).
   void reset();
-  // SensorData from MuJoCo's sensors (encoders, IMU, F/T), plus noise if enabled. The values
-  // belong to the current state with the previous command's torques (zero-order hold).
+  // SensorData from MuJoCo's sensors (encoders, IMU, F/T), plus noise if enabled, F/T offsets,
+  // and each group as it was `latency` calls ago (PlantPerturbation; call once per tick). The
+  // values belong to the current state with the previous command's torques (zero-order hold).
   void readSensors(Sensors& s);
-  // Joint torque = k_t · current, clamped to the motor's ctrlrange (URDF effort). A non-finite
-  // current is applied as zero.
+  // Joint torque = k_t · current (the plant's k_t, with any torque-constant error), clamped to
+  // the motor's ctrlrange (URDF effort); with actuator latency, the current of that many calls
+  // ago. A non-finite current is applied as zero.
   void applyCommand(const Command& c);
   // One control period (substeps physics steps), then recompute the sensors.
   void step();
@@ -107,7 +111,12 @@ class Simulation {
   // scene's collision box: what the measured ZMP is checked against.
   const std::array<Eigen::Vector2d, 2>& soleRectangle(int c) const { return sole_rect_[c]; }
   bool nonFootContact() const;              // a robot geom other than a sole plate is in contact
-  bool feetTouch() const;                   // the two sole plates touch each other (corrupts the F/T CoP)
+  bool feetTouch() const;
+  // The body the sole plate of foot c touches (its first contact; 0: the world, i.e. the floor),
+  // -1 when it touches nothing.
+  int soleSupport(int c) const;
+  // Pose of foot c's sole frame in body b's frame (b = 0: world).
+  Eigen::Isometry3d soleInBody(int c, int b) const;                   // the two sole plates touch each other (corrupts the F/T CoP)
 
   // The F/T wrench of foot c as SensorData::ft holds it, without sensor noise: what the run's
   // ZMP metrics judge (noise on a lightly loaded foot would move its CoP by centimetres).
@@ -126,6 +135,8 @@ class Simulation {
  private:
   int sensorAdr(const std::string& name, int dim) const;
   void addDeliveredTorque();  // one physics step's share of deliveredTorque()
+  void applyModelPerturbation();
+  void addNoise(Sensors& s);  // payload, masses, friction, contacts (constructor)
 
   SimulationOptions options_;
   PlantConfig plant_;
@@ -143,6 +154,11 @@ class Simulation {
   std::mt19937 rng_;
   VectorJ delivered_ = VectorJ::Zero();  // deliveredTorque()
   Eigen::Vector3d gyro_bias_ = Eigen::Vector3d::Zero(), accel_bias_ = Eigen::Vector3d::Zero();  // IMU frame
+  VectorJ k_t_plant_;                    // k_t_ with the torque-constant errors (what the motors have)
+  std::vector<Sensors> sensor_history_;  // ring of the last readings (latency), newest at sensor_head_
+  int sensor_head_ = 0, sensor_count_ = 0;
+  std::vector<VectorJ> current_history_;  // ring of commanded currents (actuator latency)
+  int current_head_ = 0;
 };
 
 }  // namespace hqp::sim

@@ -44,7 +44,11 @@ hqp::sim::RunSummary runPreset(const std::string& name, const std::string& estim
 
 void expectAccurate(const hqp::sim::RunSummary& r, double velocity_rms, const char* what) {
   SCOPED_TRACE(what);
-  EXPECT_TRUE(r.passed) << (r.fell ? "fell: " + r.fall_reason : "safe mode or ZMP outside");
+  // Balance kept (no fall, ZMP inside, no safe mode); the stricter contact rules (sole slide,
+  // tilt) are the scenario matrix's business, not the estimator's.
+  EXPECT_FALSE(r.fell) << r.fall_reason;
+  EXPECT_TRUE(r.zmp_inside);
+  EXPECT_EQ(r.safe_mode_ticks, 0);
   ASSERT_TRUE(r.estimator.available);
   EXPECT_GT(r.estimator.base_velocity.n, 1000);
   EXPECT_LE(r.estimator.base_velocity.rms, velocity_rms);
