@@ -313,7 +313,7 @@ std::string markdownTable(const std::vector<nlohmann::ordered_json>& records) {
     << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   bool push_x = false;
   for (const auto& j : records) {
-    if (j.contains("directions") || j.contains("ablation")) continue;  // their own tables
+    if (j.contains("directions") || j.contains("ablation") || j.contains("cells")) continue;  // their own tables
     push_x = push_x || j["scenario"] == "push_x";
     std::string result = j["passed"].get<bool>() ? "PASS" : "FAIL";
     if (j["fell"].get<bool>()) result += fmt(" (fell at %.2f s: ", j["fall_time"].get<double>()) + j["fall_reason"].get<std::string>() + ")";
@@ -343,7 +343,7 @@ std::string markdownTable(const std::vector<nlohmann::ordered_json>& records) {
   // Moving supports: what the right foot went through (MuJoCo ground truth, 20 Hz low-pass).
   bool header = false;
   for (const auto& j : records) {
-    if (j.contains("directions") || !j.contains("supports")) continue;
+    if (j.contains("directions") || j.contains("cells") || !j.contains("supports")) continue;
     if (!header) {
       s << "\n| moving support | result | right-foot peak velocity x / y / z (m/s) | peak angular velocity x / y / z "
            "(rad/s) | max roll / pitch / yaw (°) | min ZMP margin (mm) |\n|---|---|---|---|---|---|\n";

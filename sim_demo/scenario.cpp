@@ -330,6 +330,9 @@ const std::vector<Parameter>& parameters() {
          for (SupportMotion& m : p.supports) m.ramp = p.support_ramp;
        },
        [](const P& p) { return formatDouble(p.support_ramp); }},
+      {"robustness_matrix", "robustness: the matrix YAML file (default: robots/walker3/robustness.yaml)",
+       [](P& p, S, S v) { p.robustness_matrix = v; },
+       [](const P& p) { return p.robustness_matrix.empty() ? std::string("default") : p.robustness_matrix; }},
       // Plant perturbations (plant only; docs/scenarios.md, "Plant perturbations").
       {"payload", "plant: none or LINK:MASS:X:Y:Z, a point mass (kg) at (m) in the link's frame",
        [](P& p, S k, S v) {
@@ -456,7 +459,7 @@ std::vector<Push> series(double first, double spacing, const std::vector<double>
 std::vector<std::string> scenarioNames() {
   return {"stand",      "push_x",     "push_y",      "push_sweep", "friction_ablation", "seesaw_x",    "seesaw_y",
           "skate_x",    "skate_y",    "skate_z",     "skate_roll", "skate_pitch", "skate_yaw",
-          "skate_mixed", "skate_sweep"};
+          "skate_mixed", "skate_sweep", "robustness"};
 }
 
 const std::vector<std::string>& supportAxes() {
@@ -575,6 +578,9 @@ ScenarioParams presetScenario(const std::string& name) {
     p.description = "largest single impulse survived along +X, -X, +Y, -Y (bisection)";
     p.sweep = true;
     p.run.duration = p.sweep_params.push_time + p.sweep_params.observe;
+  } else if (name == "robustness") {
+    p.description = "experiments x plant perturbations x controllers x noise seeds, pass rates and margins (--jobs N)";
+    p.robustness = true;
   } else if (name == "friction_ablation") {
     p.description = "base scenarios x joint friction compensation on / off / model 30 % low / high (Sec. V-A)";
     p.ablation = true;

@@ -54,6 +54,8 @@ struct ScenarioParams {
   std::string estimator = "config";       // config (controller YAML's), stance or kinematic_inertial
   PlantPerturbation perturbation;         // the plant's differences from the controller's model
   bool ablation = false;                  // friction_ablation: runs instead of one run
+  bool robustness = false;                // robustness: the matrix of robustness_matrix (sim_demo processes)
+  std::string robustness_matrix;          // its YAML file; empty: robots/walker3/robustness.yaml
   AblationParams ablation_params;
   // Moving supports: the scene file (in the directory of the default scene.xml) and
   // one motion per servo axis of kSupportAxes (amplitude 0 and offset 0: not driven).

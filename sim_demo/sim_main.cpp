@@ -7,6 +7,7 @@
 //   sim_demo --scenario NAME --record FILE [--record-start S] [--record-duration S] [--record-every N]
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -19,6 +20,7 @@
 #include "push_sweep.hpp"
 #include "recording.hpp"
 #include "report.hpp"
+#include "robustness.hpp"
 #include "run.hpp"
 #include "scenario.hpp"
 #include "simulation.hpp"
@@ -31,6 +33,9 @@
 #endif
 #ifndef HQP_SIM_CONTROLLER_CONFIG
 #define HQP_SIM_CONTROLLER_CONFIG ""
+#endif
+#ifndef HQP_SIM_ROBUSTNESS
+#define HQP_SIM_ROBUSTNESS ""
 #endif
 #ifndef HQP_SIM_PYTHON
 #define HQP_SIM_PYTHON "/usr/bin/python3"
@@ -47,6 +52,7 @@ using hqp::sim::ScenarioParams;
 struct Paths {
   std::string scene = HQP_SIM_SCENE, plant = HQP_SIM_PLANT, controller_config = HQP_SIM_CONTROLLER_CONFIG;
   std::string python = HQP_SIM_PYTHON, plot_script = HQP_SIM_PLOT_SCRIPT;
+  std::string robustness = HQP_SIM_ROBUSTNESS;
 };
 
 std::string shellQuote(const std::string& s) {
@@ -136,6 +142,7 @@ int main(int argc, char** argv) {
   bool list = false, all = false, no_video = false, no_plots = false;
   std::vector<std::string> names, sets, video_only;
   std::string config, out = "out", controller, driver_name = "controller";
+  int jobs = 0;
   app.add_flag("--list", list, "list the scenarios and their parameters");
   app.add_option("--scenario", names, "scenario to run (repeatable); see --list");
   app.add_flag("--all", all, "run every scenario");
@@ -145,6 +152,7 @@ int main(int argc, char** argv) {
   app.add_flag("--no-video", no_video, "skip the MP4 videos");
   app.add_option("--video-only", video_only, "render videos only for these scenarios (repeatable)");
   app.add_flag("--no-plots", no_plots, "skip the PNG plots");
+  app.add_option("--jobs", jobs, "robustness: simulations at a time (0: one per core)")->capture_default_str();
   app.add_option("--controller", controller, "hqp (strict hierarchy) or wqp (weighted); same as --set controller=")
       ->check(CLI::IsMember({"hqp", "wqp"}));
   app.add_option("--driver", driver_name, "controller (balance controller) or pd (joint PD stand-in, no QP)")
@@ -179,7 +187,10 @@ int main(int argc, char** argv) {
     }
     return 0;
   }
-  if (all) names = hqp::sim::scenarioNames();
+  if (all) {  // every scenario but the robustness matrix, which runs the others many times over
+    names = hqp::sim::scenarioNames();
+    names.erase(std::remove(names.begin(), names.end(), "robustness"), names.end());
+  }
   if (names.empty()) {
     std::fprintf(stderr, "sim_demo: nothing to run: give --scenario NAME, --all or --list\n");
     return 2;
@@ -208,6 +219,30 @@ int main(int argc, char** argv) {
   try {
     fs::create_directories(out);
     for (const ScenarioParams& p : scenarios) {
+      if (p.robustness) {
+        const std::string dir = (fs::path(out) / "robustness").string();
+        const std::string matrix = p.robustness_matrix.empty() ? paths.robustness : p.robustness_matrix;
+        std::printf("\n== robustness: %s (%s) ==\n", p.description.c_str(), matrix.c_str());
+        const hqp::sim::RobustnessMatrix m = hqp::sim::loadRobustnessMatrix(matrix);
+        const std::vector<std::string> common = {"--scene", paths.scene, "--plant", paths.plant, "--controller-config",
+                                                 paths.controller_config};
+        nlohmann::ordered_json record =
+            hqp::sim::runRobustness(m, fs::read_symlink("/proc/self/exe").string(), common, dir, jobs);
+        record["files"] = {{"json", dir + "/robustness.json"}, {"markdown", dir + "/robustness.md"}};
+        const fs::path script = fs::path(paths.plot_script).parent_path() / "plot_robustness.py";
+        if (!no_plots && !paths.plot_script.empty() && fs::exists(script)) {
+          const std::string png = dir + "/robustness.png";
+          const std::string cmd = shellQuote(paths.python) + " " + shellQuote(script.string()) + " " +
+                                  shellQuote(dir + "/robustness.json") + " --out " + shellQuote(png);
+          if (std::system(cmd.c_str()) == 0 && fs::exists(png)) record["files"]["heatmap"] = png;
+          else std::fprintf(stderr, "sim_demo: plotting failed (%s); the JSON is complete\n", cmd.c_str());
+        }
+        std::printf("\n%s\nrobustness: %s/robustness.md, robustness.json%s\n", hqp::sim::robustnessMarkdown(record).c_str(),
+                    dir.c_str(), record["files"].contains("heatmap") ? ", robustness.png" : "");
+        all_passed = all_passed && record["passed"].get<bool>();
+        records.push_back(record);
+        continue;
+      }
       if (p.ablation) {
         const std::string dir = (fs::path(out) / (p.name + (p.controller == "hqp" ? "" : "_" + p.controller))).string();
         std::printf("\n== %s: %s ==\n", p.name.c_str(), p.description.c_str());
@@ -258,7 +293,7 @@ int main(int argc, char** argv) {
       records.push_back(record);
     }
     bool plain = false;  // a record with a row in the main table
-    for (const auto& r : records) plain = plain || !r.contains("ablation");
+    for (const auto& r : records) plain = plain || !(r.contains("ablation") || r.contains("cells"));
     std::string table = plain ? hqp::sim::markdownTable(records) : std::string();
     for (const auto& r : records) {
       if (r.contains("ablation")) table += "\n" + hqp::sim::ablationMarkdown(r);
