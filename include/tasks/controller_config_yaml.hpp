@@ -222,7 +222,7 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
   {
     const std::string p = "planner";
     const YAML::Node n = r.map(root, "", p, {"safe_margin", "com_height", "sole", "torso_yaw_offset",
-                                            "follow_acceleration_cutoff", "follow_translation",
+                                            "follow_acceleration_cutoff", "follow_translation", "hold_tipping_axis",
                                             "com_reference_cutoff", "support_acceleration_from_estimator"});
     PlannerParameters& pl = c.planner;
     pl.safe_margin = r.atLeast(n, p, "safe_margin", 0.0, false);
@@ -237,6 +237,7 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
     if (n["follow_acceleration_cutoff"])
       pl.follow_acceleration_cutoff = r.atLeast(n, p, "follow_acceleration_cutoff", 0.0, false);
     if (n["follow_translation"]) pl.follow_translation = r.boolean(n, p, "follow_translation");
+    if (n["hold_tipping_axis"]) pl.hold_tipping_axis = r.boolean(n, p, "hold_tipping_axis");
     if (n["support_acceleration_from_estimator"])
       pl.support_acceleration_from_estimator = r.boolean(n, p, "support_acceleration_from_estimator");
     if (n["com_reference_cutoff"])

@@ -51,6 +51,11 @@ struct PlannerParameters {
   double follow_acceleration_cutoff = 0.0;
   // A foot whose ZMP left the safe region holds only its orientation; its translation follows.
   bool follow_translation = false;
+  // With follow_translation: hold the orientation only about the axis the foot can tip over,
+  // the sole edge its ZMP approaches (x edges: pitch, y edges: roll), and follow the rest,
+  // yaw always (a foot cannot tip about its normal: holding yaw on a turning support makes it
+  // twist on the support).
+  bool hold_tipping_axis = false;
   // Hz, low-pass of the feet's midpoint that the CoM reference follows; 0 = the midpoint itself.
   double com_reference_cutoff = 0.0;
   // The linear feed-forward acceleration of a following foot: false = the low-passed finite
@@ -111,9 +116,24 @@ class TaskPlanner {
         refs.contact_acceleration[c] = acceleration_[c];
       } else if (params_.follow_translation && in_contact[c]) {
         // Orientation held (previous reference, zero angular velocity); translation followed.
-        refs.contact_pose[c].translation() = dyn.placement(c).translation();
+        const auto& X = dyn.placement(c);
+        refs.contact_pose[c].translation() = X.translation();
         refs.contact_velocity[c] << v.template head<3>(), Eigen::Vector3d::Zero();
         refs.contact_acceleration[c].template head<3>() = acceleration_[c].template head<3>();
+        if (params_.hold_tipping_axis) {
+          // Sole-frame axes: hold x (roll) only near a y edge, y (pitch) only near an x edge.
+          const Eigen::Vector3d keep(insideBand(cop[c].y(), params_.sole_y_min, params_.sole_y_max) ? 1.0 : 0.0,
+                                     insideBand(cop[c].x(), params_.sole_x_min, params_.sole_x_max) ? 1.0 : 0.0,
+                                     1.0);
+          const Eigen::Matrix3d R_held = refs.contact_pose[c].linear();
+          const Eigen::AngleAxisd d(R_held.transpose() * X.linear());  // held -> measured, held frame
+          const Eigen::Vector3d e = keep.cwiseProduct(d.angle() * d.axis());
+          refs.contact_pose[c].linear() =
+              R_held * (e.norm() > 0.0 ? Eigen::AngleAxisd(e.norm(), e / e.norm()).toRotationMatrix()
+                                       : Eigen::Matrix3d::Identity());
+          const Eigen::Matrix3d& R = X.linear();  // followed angular velocity, sole frame components
+          refs.contact_velocity[c].template tail<3>() = R * keep.cwiseProduct(R.transpose() * v.template tail<3>());
+        }
       } else {
         refs.contact_velocity[c].setZero();  // hold the previous pose
       }
@@ -162,6 +182,11 @@ class TaskPlanner {
   const PlannerParameters& parameters() const { return params_; }
 
  private:
+  // The ZMP coordinate inside [lo + safe_margin, hi - safe_margin] (NaN: outside).
+  bool insideBand(double z, double lo, double hi) const {
+    return z >= lo + params_.safe_margin && z <= hi - params_.safe_margin;
+  }
+
   bool insideSafeRegion(const Eigen::Vector2d& zmp) const {
     const double m = params_.safe_margin;
     // A NaN ZMP compares false and so is outside.

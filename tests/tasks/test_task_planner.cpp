@@ -266,3 +266,44 @@ TEST_F(Planner, FeedForwardAccelerationOfAFollowingFoot) {
   EXPECT_TRUE(refs.contact_acceleration[0].isZero(0.0));
   EXPECT_GT(refs.contact_acceleration[1](0), 0.5 * a);
 }
+
+// hold_tipping_axis: outside the safe region only the rotation about the edge the ZMP is near
+// is held (x edge: pitch about the sole's y axis; y edge: roll about its x axis); yaw and the
+// other tilt follow the foot. The whole robot is rotated rigidly about one world axis, so the
+// soles' measured orientation is that rotation (the soles are level in the crouch).
+TEST_F(Planner, HoldTippingAxisHoldsOnlyTheAxisOfTheNearEdge) {
+  params.follow_translation = true;
+  params.hold_tipping_axis = true;
+  const Eigen::Vector2d near_x_edge(0.095, 0.0), near_y_edge(0.0, 0.045);
+  struct Case {
+    Eigen::Vector3d axis;
+    Eigen::Vector2d zmp;
+    bool followed;
+  };
+  const Case cases[] = {{Eigen::Vector3d::UnitX(), near_x_edge, true},   // roll, toe edge: follows
+                        {Eigen::Vector3d::UnitX(), near_y_edge, false},  // roll, side edge: held
+                        {Eigen::Vector3d::UnitY(), near_x_edge, false},  // pitch, toe edge: held
+                        {Eigen::Vector3d::UnitY(), near_y_edge, true},   // pitch, side edge: follows
+                        {Eigen::Vector3d::UnitZ(), near_x_edge, true},   // yaw: always follows
+                        {Eigen::Vector3d::UnitZ(), near_y_edge, true}};
+  for (const Case& k : cases) {
+    planner.configure(params, Robot::total_mass);
+    at(crouch());
+    step(centre);
+    VectorQ q = crouch();
+    const Eigen::Quaterniond rot(Eigen::AngleAxisd(0.05, k.axis));
+    q(3) = rot.w();
+    q.segment<3>(4) = rot.vec();
+    VectorV v = VectorV::Zero();
+    v.segment<3>(3) = 0.3 * k.axis;  // base angular velocity (base frame = world axes here up to 0.05 rad)
+    at(q, v);
+    step({k.zmp, Eigen::Vector2d::Zero()});
+    SCOPED_TRACE(testing::Message() << "axis " << k.axis.transpose() << ", ZMP " << k.zmp.transpose());
+    const Eigen::Matrix3d expected = k.followed ? Eigen::Matrix3d(dyn.placement(0).linear()) : Eigen::Matrix3d::Identity();
+    EXPECT_TRUE(refs.contact_pose[0].linear().isApprox(expected, 1e-9)) << refs.contact_pose[0].linear();
+    const Eigen::Vector3d w = dyn.velocity(0).tail<3>();
+    EXPECT_GT(w.norm(), 0.1);
+    EXPECT_LT((refs.contact_velocity[0].tail<3>() - (k.followed ? w : Eigen::Vector3d::Zero())).norm(), 1e-9);
+    EXPECT_LT((refs.contact_pose[0].translation() - dyn.placement(0).translation()).norm(), 1e-12);
+  }
+}
