@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <tuple>
+#include <type_traits>
 #include <utility>
 
 #include "hqp/hqp_wbc.hpp"
@@ -69,6 +70,10 @@ template <class Wbc, class F, std::size_t... P>
 void forEachItemOfLevels(Wbc& wbc, F& f, std::index_sequence<P...>) {
   (forEachItemOfLevel(wbc.template level<static_cast<int>(P)>(), f), ...);
 }
+template <class T, class = void>
+struct HasResetState : std::false_type {};
+template <class T>
+struct HasResetState<T, std::void_t<decltype(std::declval<T&>().resetState())>> : std::true_type {};
 // f(item) for every task and constraint of every level, in priority order.
 template <class Wbc, class F>
 void forEachItem(Wbc& wbc, F f) {
@@ -87,6 +92,15 @@ void updateHierarchy(Wbc& wbc, const Dyn& dyn, const References<NC>& refs) noexc
 template <class Wbc, int NJ>
 void configureHierarchy(Wbc& wbc, const BalanceParameters<NJ>& p) {
   detail::forEachItem(wbc, [&](auto& item) { item.configure(p); });
+}
+
+// Back to the initial internal state for the items that keep one (an integral); set-up or
+// reset time, not in the tick.
+template <class Wbc>
+void resetHierarchyState(Wbc& wbc) noexcept {
+  detail::forEachItem(wbc, [](auto& item) {
+    if constexpr (detail::HasResetState<std::decay_t<decltype(item)>>::value) item.resetState();
+  });
 }
 
 }  // namespace hqp::tasks

@@ -21,6 +21,17 @@ struct BalanceParameters {
   PdGains foot_angular{400.0, 40.0};
   PdGains com{9.0, 6.0};
   PdGains com_vertical{1.0, 2.0};
+  // Integral of the horizontal CoM error, beyond the paper (0 = the paper's PD): a = ... + ki ∫e dt
+  // with |∫e dt| ≤ com_integral_limit per axis. Uncompensated joint stiction holds a soft CoM
+  // loop millimetres off its reference; the integral takes it back (docs/tasks.md).
+  double com_ki = 0.0;               // 1/s³
+  double com_integral_limit = 0.02;  // m·s
+  double dt = 0.001;                 // s, the control period (the controller sets it from its own)
+  // Capture-point gain schedule of the horizontal CoM rows, beyond the paper: the gains blend from
+  // `com` to `com_high` as |e + ė/ω| grows from com_dcm_low to com_dcm_high (m); off while
+  // com_dcm_high <= com_dcm_low.
+  PdGains com_high{9.0, 6.0};
+  double com_dcm_low = 0.0, com_dcm_high = 0.0;
   PdGains torso{200.0, 28.28};
   double mu = 0.6;        // friction coefficient (rubber sole on floor ~0.8–1; kept conservative)
   double fz_min = 10.0;   // N, unilateral margin: ~2 % of the weight keeps a lightly loaded foot down

@@ -58,6 +58,7 @@ class Controller {
     estimator_.configure(config_.estimator);
     planner_.configure(config_.planner, Robot::total_mass, config_.dt);
     joint_.configure(config_.joint);
+    config_.balance.dt = config_.dt;
     configureHierarchy(hqp_, config_.balance);
     configureHierarchy(wqp_, config_.balance);
     reset();
@@ -69,6 +70,8 @@ class Controller {
     estimator_.reset();
     planner_.reset();
     hqp_.resetWarmStart();
+    resetHierarchyState(hqp_);
+    resetHierarchyState(wqp_);
     started_ = false;
     diag_ = Diagnostics{};
     tau_hold_.setZero();

@@ -193,12 +193,27 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
     const YAML::Node n = r.map(root, "", p,
                                {"foot_linear", "foot_angular", "com", "com_vertical", "torso", "mu",
                                 "fz_min", "cop_region", "torque_limit", "torso_weight", "force_weight",
-                                "torsion_radius"});
+                                "torsion_radius", "com_integral", "com_schedule"});
     BalanceParameters<nj>& b = c.balance;
     b.foot_linear = r.gains(n, p, "foot_linear");
     b.foot_angular = r.gains(n, p, "foot_angular");
     b.com = r.gains(n, p, "com");
     b.com_vertical = r.gains(n, p, "com_vertical");
+    if (n["com_integral"]) {  // optional, beyond the paper
+      const YAML::Node g = r.map(n, p, "com_integral", {"ki", "limit"});
+      b.com_ki = r.atLeast(g, p + ".com_integral", "ki", 0.0, false);
+      b.com_integral_limit = r.atLeast(g, p + ".com_integral", "limit", 0.0, false);
+    }
+    if (n["com_schedule"]) {  // optional, beyond the paper
+      const YAML::Node g = r.map(n, p, "com_schedule", {"dcm_low", "dcm_high", "kp", "kd"});
+      const std::string q = p + ".com_schedule";
+      b.com_dcm_low = r.atLeast(g, q, "dcm_low", 0.0, false);
+      b.com_dcm_high = r.atLeast(g, q, "dcm_high", 0.0, false);
+      b.com_high = PdGains{r.atLeast(g, q, "kp", 0.0, false), r.atLeast(g, q, "kd", 0.0, false)};
+      if (!(b.com_dcm_high > b.com_dcm_low)) {
+        r.fail("'" + q + ".dcm_high' must exceed dcm_low");
+      }
+    }
     b.torso = r.gains(n, p, "torso");
     b.mu = r.atLeast(n, p, "mu", 0.0, true);
     b.fz_min = r.atLeast(n, p, "fz_min", 0.0, false);

@@ -440,6 +440,43 @@ TEST_F(BalanceHierarchy, OperationalTasksPullTowardsTheReference) {
   EXPECT_TRUE(torso.A.rightCols<12>().isZero(0.0));
 }
 
+// The CoM task's two extensions beyond the paper, at rest (Ȧ_G v = 0, ė = 0), against closed
+// forms: the capture-point schedule blends the gains by s = (|e| − low)/(high − low) per axis
+// (|e + ė/ω| = |e| here), and the integral adds ki Σ e dt, clamped, until resetState().
+TEST_F(BalanceHierarchy, ComScheduleAndIntegral) {
+  hqp::tasks::BalanceParameters<Robot::nj> p = params;
+  p.com = {4.0, 3.0};
+  p.com_high = {20.0, 10.0};
+  p.com_dcm_low = 0.03;
+  p.com_dcm_high = 0.06;
+  p.com_ki = 3.0;
+  p.com_integral_limit = 2e-4;
+  p.dt = 0.001;
+  Refs r = refs;
+  r.com += Eigen::Vector3d(0.02, -0.05, 0.0);
+  const Eigen::Vector2d e = (r.com - dyn.com()).head<2>();
+  ASSERT_NEAR(e.x(), 0.02, 1e-9);
+  hqp::tasks::LinearMomentumTask<Layout> com;
+  com.configure(p);
+  const double s_y = (0.05 - 0.03) / (0.06 - 0.03);
+  const Eigen::Vector2d kp(4.0, (1.0 - s_y) * 4.0 + s_y * 20.0);
+  for (int k = 1; k <= 5; ++k) {
+    com.update(dyn, r);
+    // Σ e dt after k ticks, clamped to ±2e-4 m·s per axis.
+    const Eigen::Vector2d integral = (k * 0.001 * e).cwiseMax(-2e-4).cwiseMin(2e-4);
+    const Eigen::Vector2d a = kp.cwiseProduct(e) + 3.0 * integral;
+    EXPECT_LT((com.b.head<2>() - dyn.mass() * a).norm(), 1e-9) << "tick " << k;
+  }
+  com.resetState();
+  com.update(dyn, r);
+  EXPECT_LT((com.b.head<2>() - dyn.mass() * (kp.cwiseProduct(e) + 3.0 * 0.001 * e)).norm(), 1e-9);
+  // Off (the paper's PD) with the defaults: ki = 0, no schedule.
+  hqp::tasks::LinearMomentumTask<Layout> plain;
+  plain.configure(params);
+  plain.update(dyn, r);
+  EXPECT_LT((plain.b.head<2>() - dyn.mass() * params.com.kp * e).norm(), 1e-9);
+}
+
 // A robot in motion (every velocity non-zero) with velocity references equal to the current
 // velocities: the feet (level 2) and the CoM (level 3) are asked for zero classical
 // acceleration, which holds only if the tasks subtract J̇v and Ȧ_G v with the right sign.
