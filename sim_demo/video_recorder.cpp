@@ -109,16 +109,19 @@ void VideoRecorder::render(mjData* d, const std::string& caption, const std::str
   mjr_rectangle({half - 1, 0, 2, height_}, 0.1f, 0.1f, 0.1f, 1.0f);  // divider
   mjr_overlay(mjFONT_NORMAL, mjGRID_BOTTOMLEFT, panel[0], "front", nullptr, &context_mj_);
   mjr_overlay(mjFONT_NORMAL, mjGRID_BOTTOMLEFT, panel[1], "right side", nullptr, &context_mj_);
-  char t[32];
-  std::snprintf(t, sizeof(t), "t = %.2f s", d->time);
-  const std::string label = title_.empty() ? std::string(t) : title_ + "\n" + t;
-  mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, full, label.c_str(), nullptr, &context_mj_);
-  if (!caption.empty()) mjr_overlay(mjFONT_BIG, mjGRID_TOPRIGHT, full, caption.c_str(), nullptr, &context_mj_);
-  if (!banner.empty()) {
-    // Two lines: a long reason would not fit the big font's width.
-    mjr_label({0, height_ / 2 + 10, width_, 44}, mjFONT_BIG, banner.c_str(), 0.75f, 0.08f, 0.08f, 0.85f, 1, 1, 1,
+  if (banner.empty()) {
+    char t[32];
+    std::snprintf(t, sizeof(t), "t = %.2f s", d->time);
+    const std::string label = title_.empty() ? std::string(t) : title_ + "\n" + t;
+    mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, full, label.c_str(), nullptr, &context_mj_);
+    if (!caption.empty()) mjr_overlay(mjFONT_BIG, mjGRID_TOPRIGHT, full, caption.c_str(), nullptr, &context_mj_);
+  } else {
+    // Across the top, where it hides sky rather than the hips and feet; two lines because a long
+    // reason does not fit one line of the big font.
+    const std::string second = title_.empty() ? detail : title_ + ": " + detail;
+    mjr_label({0, height_ - 44, width_, 44}, mjFONT_BIG, banner.c_str(), 0.75f, 0.08f, 0.08f, 0.9f, 1, 1, 1,
               &context_mj_);
-    mjr_label({0, height_ / 2 - 22, width_, 32}, mjFONT_NORMAL, detail.c_str(), 0.75f, 0.08f, 0.08f, 0.85f, 1, 1, 1,
+    mjr_label({0, height_ - 80, width_, 36}, mjFONT_BIG, second.c_str(), 0.75f, 0.08f, 0.08f, 0.9f, 1, 1, 1,
               &context_mj_);
   }
   mjr_readPixels(rgb_.data(), nullptr, full, &context_mj_);
