@@ -32,7 +32,7 @@ EGLDisplay openDisplay() {
 
 VideoRecorder::VideoRecorder(const mjModel* m, const std::string& path, int width, int height, int fps,
                              int track_body, const std::string& title)
-    : m_(m), width_(width), height_(height), fps_(fps), track_body_(track_body), title_(title) {
+    : m_(m), width_(width), height_(height), fps_(fps), track_body_(std::max(0, track_body)), title_(title) {
   EGLDisplay dpy = openDisplay();
   display_ = dpy;
   // Without EGL_PBUFFER_BIT no config is found on Mesa's device platform.
@@ -61,14 +61,14 @@ VideoRecorder::VideoRecorder(const mjModel* m, const std::string& path, int widt
     width_ = context_mj_.offWidth;  // <visual><global offwidth offheight> of the scene
     height_ = context_mj_.offHeight;
   }
-  // Free cameras whose look-at point follows the robot (frame()): azimuth is the direction the
+  // Free cameras whose look-at point follows the robot (render()): azimuth is the direction the
   // camera looks in, so 160 deg looks back at the robot's front from slightly to its right and
   // 110 deg at its right side from slightly to the front; the 20 deg offsets keep depth visible.
   // Low elevation: foot roll and pitch show as tilted soles against the floor.
   const double azimuth[2] = {160.0, 110.0};
   for (int i = 0; i < 2; ++i) {
     cameras_[i].type = mjCAMERA_FREE;
-    cameras_[i].distance = 2.6;  // the whole 1.6 m robot in a 3:2 portrait panel
+    cameras_[i].distance = 2.6;  // the whole 1.6 m robot in a half-width (portrait) panel
     cameras_[i].azimuth = azimuth[i];
     cameras_[i].elevation = -8.0;
   }
