@@ -121,7 +121,7 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
     if (o.video) {
       r.video_path = o.out_dir + "/" + o.scenario + ".mp4";
       video = std::make_unique<VideoRecorder>(sim.model(), r.video_path, o.video_width, o.video_height, o.video_fps,
-                                              mj_name2id(sim.model(), mjOBJ_BODY, Robot::bodies[0].name));
+                                              mj_name2id(sim.model(), mjOBJ_BODY, Robot::bodies[0].name), o.scenario);
     }
   }
   std::vector<int> support_actuators;
@@ -358,6 +358,11 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
       if (!r.fall_reason.empty()) {
         r.fell = true;
         r.fall_time = sim.time();
+        if (video) {  // the run stops here: the video shows where and why
+          const auto v0 = std::chrono::steady_clock::now();
+          video->fall(sim.data(), r.fall_time, r.fall_reason);
+          video_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - v0).count();
+        }
         break;
       }
     }

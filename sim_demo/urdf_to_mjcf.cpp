@@ -6,7 +6,8 @@
 // inertias as written), and the compiled model is written back as MJCF with %.17g numbers
 // (mj_saveLastXML would round them to 6 digits). Kinematics and inertias therefore come only from
 // the URDF. Added here: joint friction, damping and armature from the plant file, one torque motor
-// per joint (gear 1, ctrlrange = URDF effort), sites and sensors (IMU, 6-axis F/T, encoders).
+// per joint (gear 1, ctrlrange = URDF effort), sites and sensors (IMU, 6-axis F/T, encoders), and
+// the URDF's <visual> shapes as drawn-only geoms (no contact, no mass).
 //
 // Sole plates: each foot's collision geometry is moved (same world placement) into the massless
 // sole body, and the F/T site is put in that body at the F/T frame. MuJoCo's force/torque sensors
@@ -83,6 +84,13 @@ std::string num(double x) {
   return b;
 }
 
+// Drawn-only shapes need no round trip: 6 digits.
+std::string shortNum(double x) {
+  char b[40];
+  std::snprintf(b, sizeof(b), "%.6g", x);
+  return b;
+}
+
 std::string nums(const double* x, int n) {
   std::string s;
   for (int i = 0; i < n; ++i) s += (i ? " " : "") + num(x[i]);
@@ -112,6 +120,7 @@ struct Writer {
   const mjModel* m;
   mjData* d;
   const hqp::sim::PlantConfig& plant;
+  const urdf::ModelInterface& urdf_model;
   std::set<int> foot_bodies;  // their geoms move into the sole bodies
   std::ostringstream out;
 
@@ -126,6 +135,48 @@ struct Writer {
     }
     out << ind << "<geom name=\"" << geom_name << "\" type=\"" << type << "\" size=\"" << size << "\" pos=\""
         << nums(pos, 3) << "\" quat=\"" << nums(quat, 4) << "\"/>\n";
+  }
+
+  // The link's URDF <visual> shapes as drawn-only geoms: no contact (contype/conaffinity 0) and
+  // mass 0, so that the plant stays what <inertial> and <collision> say (inertiafromgeom is off
+  // as well). MuJoCo's reader drops them (discardvisual), so they are read here with urdfdom.
+  void visuals(const std::string& link_name, const std::string& ind) {
+    const urdf::LinkConstSharedPtr link = urdf_model.getLink(link_name);
+    if (!link) return;
+    int k = 0;
+    for (const urdf::VisualSharedPtr& v : link->visual_array) {
+      if (!v || !v->geometry) continue;
+      std::string type, size;
+      switch (v->geometry->type) {
+        case urdf::Geometry::BOX: {
+          const auto& b = static_cast<const urdf::Box&>(*v->geometry).dim;
+          type = "box";
+          size = shortNum(0.5 * b.x) + " " + shortNum(0.5 * b.y) + " " + shortNum(0.5 * b.z);
+          break;
+        }
+        case urdf::Geometry::CYLINDER: {
+          const auto& c = static_cast<const urdf::Cylinder&>(*v->geometry);
+          type = "cylinder";
+          size = shortNum(c.radius) + " " + shortNum(0.5 * c.length);
+          break;
+        }
+        case urdf::Geometry::SPHERE:
+          type = "sphere";
+          size = shortNum(static_cast<const urdf::Sphere&>(*v->geometry).radius);
+          break;
+        default: throw std::runtime_error("link " + link_name + ": unsupported visual geometry (use box, cylinder, sphere)");
+      }
+      // MuJoCo's URDF bodies sit at the link frames, so the URDF origin is the geom pose as is.
+      const urdf::Pose& p = v->origin;
+      urdf::Color c;
+      c.r = c.g = c.b = 0.5f;
+      if (v->material) c = v->material->color;
+      out << ind << "<geom name=\"" << link_name << "_visual" << k++ << "\" type=\"" << type << "\" size=\"" << size
+          << "\" pos=\"" << shortNum(p.position.x) << " " << shortNum(p.position.y) << " " << shortNum(p.position.z)
+          << "\" quat=\"" << shortNum(p.rotation.w) << " " << shortNum(p.rotation.x) << " " << shortNum(p.rotation.y)
+          << " " << shortNum(p.rotation.z) << "\" contype=\"0\" conaffinity=\"0\" group=\"1\" mass=\"0\" rgba=\""
+          << shortNum(c.r) << " " << shortNum(c.g) << " " << shortNum(c.b) << " " << shortNum(c.a) << "\"/>\n";
+    }
   }
 
   void joint(int j, const std::string& ind) {
@@ -160,6 +211,7 @@ struct Writer {
         geom(g, m->geom_pos + 3 * g, m->geom_quat + 4 * g, in2, bn + "_geom" + std::to_string(k));
       }
     }
+    visuals(bn, in2);
     if (bn == plant.imu_link) out << in2 << "<site name=\"imu\" pos=\"0 0 0\" size=\"0.01\"/>\n";
     for (const auto& ft : plant.force_torque) {
       if (bn != ft.sole) continue;
@@ -206,7 +258,7 @@ int main(int argc, char** argv) {
     mjData* d = mj_makeData(m);
     mj_kinematics(m, d);  // qpos0: every world pose at the URDF's zero configuration
 
-    Writer w{m, d, plant, {}, {}};
+    Writer w{m, d, plant, *urdf_model, {}, {}};
     for (const auto& ft : plant.force_torque) {
       const int foot = mj_name2id(m, mjOBJ_BODY, ft.foot.c_str());
       if (foot < 0 || mj_name2id(m, mjOBJ_BODY, ft.sole.c_str()) < 0) {
