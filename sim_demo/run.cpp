@@ -352,7 +352,11 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
     r.min_torso_height = std::min(r.min_torso_height, z);
     r.duration = sim.time();
     if (!r.fell) {
-      if (z < o.fall_height) r.fall_reason = "torso below " + std::to_string(o.fall_height) + " m";
+      if (z < o.fall_height) {
+        char b[48];
+        std::snprintf(b, sizeof(b), "torso below %.2f m", o.fall_height);
+        r.fall_reason = b;
+      }
       else if (std::abs(pitch) > o.fall_tilt || std::abs(roll) > o.fall_tilt) r.fall_reason = "torso tilt";
       else if (sim.nonFootContact()) r.fall_reason = "contact other than the soles";
       if (!r.fall_reason.empty()) {
