@@ -49,6 +49,7 @@ SweepResult runPushSweep(Simulation& sim, Driver& driver, const ScenarioParams& 
         tp.supports = skate_preset.supports;
         for (SupportMotion& m : tp.supports) {
           if (!m.active()) continue;
+          if (sp.frequency > 0.0) m.frequency = sp.frequency;
           const double k = value * unit_scale / m.peakVelocity();
           m.amplitude *= k;
           m.offset *= k;

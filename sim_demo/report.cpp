@@ -87,7 +87,7 @@ nlohmann::ordered_json runRecord(const ScenarioParams& p, const RunSummary& r) {
     nlohmann::ordered_json sup = nlohmann::ordered_json::array();
     for (const SupportMotion& m : ro.supports) {
       sup.push_back({{"axis", m.axis}, {"amplitude", m.amplitude}, {"offset", m.offset}, {"frequency_hz", m.frequency},
-                     {"peak_velocity", m.peakVelocity()}, {"start_s", m.start}, {"duration_s", m.duration}});
+                     {"peak_velocity", m.peakVelocity()}, {"peak_acceleration", m.peakAcceleration()}, {"start_s", m.start}, {"duration_s", m.duration}});
     }
     j["supports"] = sup;
     const Eigen::Vector3d& w = r.foot_angular_velocity_peak[1];
@@ -158,6 +158,7 @@ nlohmann::ordered_json runRecord(const ScenarioParams& p, const RunSummary& r) {
 nlohmann::ordered_json sweepRecord(const ScenarioParams& p, const SweepResult& s) {
   nlohmann::ordered_json j = recordHeader(p, s.passed);
   j["required_impulse"] = p.sweep_params.required;
+  if (p.sweep_params.skate && p.sweep_params.frequency > 0) j["frequency_hz"] = p.sweep_params.frequency;
   j["wall_time_s"] = s.wall_time;
   nlohmann::ordered_json dirs = nlohmann::ordered_json::array();
   double tick_max = 0, tick_p999 = 0;
@@ -234,9 +235,9 @@ void printRecord(std::FILE* out, const nlohmann::ordered_json& j) {
   }
   if (j.contains("supports")) {
     for (const auto& m : j["supports"]) {
-      std::fprintf(out, "  support servo      : %s amplitude %.4g, offset %.4g, %.3g Hz, commanded peak %.3f\n",
+      std::fprintf(out, "  support servo      : %s amplitude %.4g, offset %.4g, %.3g Hz, commanded peak %.3f, peak acceleration %.1f\n",
                    m["axis"].get<std::string>().c_str(), m["amplitude"].get<double>(), m["offset"].get<double>(),
-                   m["frequency_hz"].get<double>(), m["peak_velocity"].get<double>());
+                   m["frequency_hz"].get<double>(), m["peak_velocity"].get<double>(), m["peak_acceleration"].get<double>());
     }
     const auto& v = j["right_foot_peak_velocity_m_s"];
     const auto& w = j["right_foot_peak_angular_velocity_rad_s"];

@@ -24,6 +24,7 @@ struct SweepParams {
   double push_time = 2.0;      // s after the start of each trial
   double observe = 3.0;        // s simulated after the push
   double required = 12.0;      // N·s, the sweep passes when every direction survives this (paper: 12)
+  double frequency = 0.0;      // Hz, skate_sweep: the board's frequency (0: the skate_* preset's)
 };
 
 // friction_ablation: every base scenario under every friction-compensation variant

@@ -22,6 +22,8 @@ struct SupportMotion {
   bool active() const { return amplitude != 0.0 || offset != 0.0; }
   // The sinusoid's peak rate |A| 2 pi f (the window is 1 between the ramps).
   double peakVelocity() const { return std::abs(amplitude) * 2.0 * M_PI * frequency; }
+  // Its peak acceleration |A| (2 pi f)^2: what a hand on the board must produce.
+  double peakAcceleration() const { return peakVelocity() * 2.0 * M_PI * frequency; }
 };
 
 // Target position q and velocity dq at time t: q = w(t) (offset + A sin(2 pi f (t - start) + phase)),
