@@ -92,8 +92,15 @@ TEST(ControllerConfig, ShippedFileLoads) {
   EXPECT_EQ(c.solver, Config::Solver::Hqp);
   EXPECT_EQ(c.dt, 0.001);
   EXPECT_EQ(c.balance.mu, 0.6);
-  EXPECT_EQ(c.balance.com.kp, 9.0);
-  EXPECT_EQ(c.balance.com.kd, 6.0);
+  EXPECT_EQ(c.balance.com.kp, 4.0);
+  EXPECT_EQ(c.balance.com.kd, 3.0);
+  EXPECT_EQ(c.balance.com_high.kp, 9.0);
+  EXPECT_EQ(c.balance.com_high.kd, 6.0);
+  EXPECT_EQ(c.balance.com_dcm_low, 0.07);
+  EXPECT_EQ(c.balance.com_dcm_high, 0.10);
+  EXPECT_EQ(c.balance.com_ki, 4.0);
+  EXPECT_EQ(c.balance.com_integral_limit, 0.03);
+  EXPECT_TRUE(c.planner.hold_tipping_axis);
   EXPECT_EQ(c.balance.com_vertical.kp, 1.0);
   EXPECT_EQ(c.balance.com_vertical.kd, 2.0);
   EXPECT_EQ(c.balance.torsion_radius, 0.05);
@@ -138,7 +145,8 @@ TEST(ControllerConfig, PerJointValuesMatchTheUrdfByName) {
 TEST(ControllerConfig, MissingKeyNamesKeyAndFile) {
   expectRejected("  mu: 0.6", "  # mu removed", "balance.mu");
   expectRejected("  max_tilt: 0.8", "  # gone", "safe_mode.max_tilt");
-  expectRejected("com:          {kp: 9, kd: 6}", "com:          {kp: 9}", "balance.com.kd");
+  expectRejected("com:          {kp: 4, kd: 3}", "com:          {kp: 4}", "balance.com.kd");
+  expectRejected("com_integral: {ki: 4, limit: 0.03}", "com_integral: {ki: 4}", "balance.com_integral.limit");
   expectRejected("  com_vertical: {kp: 1, kd: 2}", "  # com_vertical gone", "balance.com_vertical");
   expectRejected("  torsion_radius: 0.05", "  # torsion_radius gone", "balance.torsion_radius");
   expectRejected("    r_knee:         250", "    # r_knee", "balance.torque_limit.r_knee");
@@ -158,7 +166,10 @@ TEST(ControllerConfig, UnknownKeyIsRejected) {
 }
 
 TEST(ControllerConfig, NegativeOrInvalidValuesAreRejected) {
-  expectRejected("com:          {kp: 9, kd: 6}", "com:          {kp: -9, kd: 6}", "balance.com.kp");
+  expectRejected("com:          {kp: 4, kd: 3}", "com:          {kp: -4, kd: 3}", "balance.com.kp");
+  expectRejected("dcm_low: 0.07, dcm_high: 0.10", "dcm_low: 0.10, dcm_high: 0.07", "balance.com_schedule.dcm_high");
+  expectRejected("com_integral: {ki: 4,", "com_integral: {ki: -4,", "balance.com_integral.ki");
+  expectRejected("  hold_tipping_axis: true", "  hold_tipping_axis: 2x", "planner.hold_tipping_axis");
   expectRejected("com_vertical: {kp: 1, kd: 2}", "com_vertical: {kp: 1, kd: -2}", "balance.com_vertical.kd");
   expectRejected("  torsion_radius: 0.05", "  torsion_radius: 0", "balance.torsion_radius");
   // A foot loaded with fz_min must count as in contact.
@@ -188,6 +199,13 @@ TEST(ControllerConfig, MovingSupportOptionsDefaultToThePaperRule) {
   ASSERT_TRUE(g.found());
   EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(f.path()).planner.follow_acceleration_cutoff, 0.0);
   EXPECT_FALSE(hqp::tasks::loadControllerConfig<Robot>(g.path()).planner.follow_translation);
+  // The CoM extensions beyond the paper are off without their keys: the paper's PD.
+  EditedConfig h("  com_schedule: {", "  # com_schedule: {");
+  ASSERT_TRUE(h.found());
+  EditedConfig i("  com_integral: {", "  # com_integral: {");
+  ASSERT_TRUE(i.found());
+  EXPECT_FALSE(hqp::tasks::loadControllerConfig<Robot>(h.path()).balance.com_dcm_high > 0.0);
+  EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(i.path()).balance.com_ki, 0.0);
 }
 
 TEST(ControllerConfig, OtherSolverAndInfiniteLeakLoad) {
