@@ -80,8 +80,10 @@ def main():
             lines.append("| %s | %g | error: %s | | | |" % (r["axis"], r["frequency_hz"], r["error"]))
             continue
         lin = len(r["axis"]) == 1
-        lines.append("| %s | %g | %.2f %s | %.3f %s | %.1f %s | %.2f |" % (
-            r["axis"], r["frequency_hz"], r["largest_survived"], r["unit"], r["amplitude"], "m" if lin else "rad",
+        # No failure up to the sweep's bracket end (sweep_max x the paper's peak): a lower bound.
+        bound = "≥ " if r.get("first_failure") is None else ""
+        lines.append("| %s | %g | %s%.2f %s | %.3f %s | %.1f %s | %.2f |" % (
+            r["axis"], r["frequency_hz"], bound, r["largest_survived"], r["unit"], r["amplitude"], "m" if lin else "rad",
             r["peak_acceleration"], "m/s²" if lin else "rad/s²", PAPER[r["axis"]]))
     with open(os.path.join(a.out, "envelope.md"), "w") as fh:
         fh.write("\n".join(lines) + "\n")
@@ -101,18 +103,27 @@ def main():
         p.plot(fs, [r["largest_survived"] for r in rs], "o-", label="survived (largest)")
         p.axhline(PAPER[ax], ls="--", color="k", lw=1, label="paper's peak")
         top = max([PAPER[ax] * 1.6] + [r["largest_survived"] * 1.1 for r in rs])
-        fgrid = [f / 20.0 for f in range(2, 81)]
+        fmax = max(fs + [1.0]) * 1.1
+        fgrid = [fmax * k / 100.0 for k in range(3, 101)]
         for acc in (5.0, 10.0, 20.0):
             p.plot(fgrid, [acc / (2 * math.pi * f) for f in fgrid], ":", color="gray", lw=0.8)
-            p.text(fgrid[-1], acc / (2 * math.pi * fgrid[-1]), " %g" % acc, fontsize=7, color="gray", va="center")
+            y = acc / (2 * math.pi * fmax)
+            if y < top:
+                p.text(fmax, y, "%g " % acc, fontsize=7, color="gray", va="bottom", ha="right")
+        bounded = [r for r in rs if r.get("first_failure") is None]
+        if bounded:  # no failure up to the sweep's bracket end: a lower bound
+            p.plot([r["frequency_hz"] for r in bounded], [r["largest_survived"] for r in bounded], "^",
+                   mfc="white", color="C0", label="no failure up to the bracket end")
         p.set_ylim(0, top)
-        p.set_xlim(0, max(fs + [1.0]) * 1.1)
+        p.set_xlim(0, fmax)
         unit = "m/s" if len(ax) == 1 else "rad/s"
         p.set_title("%s (dotted: peak acceleration, %s²)" % (ax, "m/s" if len(ax) == 1 else "rad/s"), fontsize=9)
         p.set_xlabel("board frequency (Hz)", fontsize=8)
         p.set_ylabel("peak velocity (%s)" % unit, fontsize=8)
         if i == 0:
             p.legend(fontsize=7)
+    for j in range(len(axes), 6):
+        axs[j // 3][j % 3].set_visible(False)
     fig.suptitle("Walker3: largest right-board peak velocity survived vs frequency (pass rules on)", fontsize=10)
     fig.tight_layout()
     png = os.path.join(a.out, "envelope.png")
