@@ -187,6 +187,7 @@ class ActiveSetQp {
     return j >= 0 && j < mi_ && !in_ws_(j) && std::abs(up ? us_(j) : ls_(j)) < kInf;
   }
   bool subproblem();                   // xs_ = optimum on the working set
+  bool phase1Certified();              // phase 1's multipliers prove infeasibility (Farkas)
   bool multipliers();                  // lam_ for K at x = xs_ (needs y_ from subproblem())
   QpStatus iterate(bool phase1);       // the active-set loop on the current phase
   double maxViolation(const VecN& v);  // scaled, over E and C (uses ev_, cx_)
@@ -1060,6 +1061,34 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
 }
 
 template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::phase1Certified() {
+  // At phase 1's optimum Kᵀλ = −(0, t): the x part gives Σ λ_k k_k = 0 over the working set
+  // (unit rows k_k, right-hand sides rhs_k, inequality rows with μ ≥ 0). Every row written
+  // n x ≥ β with y ≥ 0 turns this into Σ y n = ρ ≈ 0 and gap = Σ y β = −Σ λ_k rhs_k: any x
+  // meeting each row to its tolerance τ_k = feasibility_tol (1 + |rhs_k|) has
+  // ρᵀx − gap ≥ −Σ |λ_k| τ_k, impossible for ‖x‖ ≤ X (far beyond the iterates) if
+  // gap > Σ |λ_k| τ_k + ‖ρ‖ X. Rows with a wrong-signed μ are left out (then in ρ).
+  const double tol = settings_.feasibility_tol;
+  d_.head(n_).setZero();  // ρ
+  double gap = 0.0, slack = 0.0;
+  for (int i = 0; i < k_; ++i) {
+    const double l = lam_(i);
+    if (i >= neq_) {
+      const int w = i - neq_, j = ws_row_(w);
+      const double mu = ws_upper_(w) ? l : -l;
+      if (ls_(j) != us_(j) && mu < 0.0) continue;
+      d_.head(n_) -= l * Cs_.row(j).head(n_).transpose();
+    } else {
+      d_.head(n_) -= l * Es_.row(eq_pos_(i)).head(n_).transpose();
+    }
+    gap -= l * rhs_(i);
+    slack += std::abs(l) * tol * (1.0 + std::abs(rhs_(i)));
+  }
+  const double X = 1e3 * (1.0 + xc_.head(n_).norm());
+  return gap > slack + d_.head(n_).norm() * X;
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
 void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::finish(QpStatus s) {
   status_ = s;
   objective_ = 0.0;
@@ -1169,9 +1198,11 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::solveOnce(const VectorX* x_
         return status_;
       }
       if (xc_(n_) > settings_.feasibility_tol) {
+        // Infeasible only with a checked certificate; a phase 1 stuck on (nearly) parallel
+        // rows whose multipliers are rounding noise is a numerical failure instead.
         x_.setZero(n_);
         nw_ = 0;
-        finish(QpStatus::Infeasible);
+        finish(phase1Certified() ? QpStatus::Infeasible : QpStatus::NumericalFailure);
         return status_;
       }
       startPhase(false);

@@ -177,4 +177,28 @@ inline double objective(const QpProblem& p, const Eigen::VectorXd& x) {
   return 0.5 * (p.A * x - p.b).squaredNorm();
 }
 
+// Lower bound on the objective at any point y from a KKT point x with multipliers (λ, μ),
+// by convexity: f(y) ≥ f(x) + ∇f(x)ᵀ(y − x), and with ∇f(x) = −Eᵀλ − Σ ±μ c + s (s the
+// stationarity residual), ∇f(x)ᵀ(y − x) ≥ −Σ μ viol_k(y) − |λ|ᵀ|E y − e| − ‖s‖ ‖y − x‖,
+// viol_k(y) ≥ 0 how far y is outside row k's active bound. Two answers that are each feasible
+// to the tolerance can differ in objective by this much, no more: with (nearly) parallel rows
+// the multipliers are huge and the tolerance-wide feasible set much larger than the exact one.
+inline double lagrangianBound(const QpProblem& p, const Eigen::VectorXd& x, const Eigen::VectorXd& lambda,
+                              const std::vector<ActiveRow>& active, const Eigen::VectorXd& y) {
+  Eigen::VectorXd s = p.A.transpose() * (p.A * x - p.b);
+  double bound = objective(p, x);
+  if (lambda.size() > 0) {
+    s += p.E.transpose() * lambda;
+    bound -= lambda.cwiseAbs().dot((p.E * y - p.e).cwiseAbs());
+  }
+  for (const ActiveRow& a : active) {
+    const Eigen::VectorXd r = p.C.row(a.row).transpose();
+    s += (a.upper ? a.mu : -a.mu) * r;
+    const double cy = r.dot(y);
+    const double viol = a.upper ? cy - p.upper(a.row) : p.lower(a.row) - cy;
+    bound -= a.mu >= 0.0 ? a.mu * std::max(viol, 0.0) : -a.mu * std::abs(viol);
+  }
+  return bound - s.norm() * (y - x).norm();
+}
+
 }  // namespace hqp::fuzz
