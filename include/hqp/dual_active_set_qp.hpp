@@ -88,7 +88,13 @@ class DualActiveSetQp {
         for (int l = 0; l < i; ++l) x[l] -= xi * R[l];
       }
     }
-    const double jn2 = J_.topLeftCorner(n, n).squaredNorm();
+    // ‖R⁻¹‖_F² over the upper triangle (the rest is zero). Summed by hand: GCC's loop analysis
+    // of Eigen's block reduction at -O3 warned of an access past a MaxN-column matrix.
+    double jn2 = 0.0;
+    for (int j = 0; j < n; ++j) {
+      const double* x = &J_(0, j);
+      for (int i = 0; i <= j; ++i) jn2 += x[i] * x[i];
+    }
     if (!(jn2 < kInf) || !(jn2 * min_sigma * min_sigma < 1.0)) return false;
     x0_.noalias() = J_.topLeftCorner(n, n) * c_.head(n);  // R⁻¹ (Q_Aᵀ b)(0:n)
     factorized_ = x0_.allFinite();
@@ -295,7 +301,9 @@ class DualActiveSetQp {
   // with r = r_ ≤ 0, each row written n x ≥ β (n = c at lower, −c at upper). With y = (1, −r)
   // ≥ 0, any x meeting every row to its tolerance τ = feasibility_tol (‖n‖ + |β|) satisfies
   // Σ y_k (n_k x − β_k) ≥ −Σ y_k τ_k, i.e. ρᵀx − gap ≥ −Σ y τ with ρ = Σ y n (rounding) and
-  // gap = Σ y β. No x with ‖x‖ ≤ X (far beyond the iterates) exists if gap exceeds both.
+  // gap = Σ y β. No x with ‖x‖ ≤ X (far beyond the iterates) exists if gap exceeds both; ρ
+  // must be rounding (‖ρ‖ ≤ 1e-12 Σ y ‖n‖), else the rows are only nearly dependent and a
+  // feasible point may lie far out.
   template <class MatC, class VecL, class VecU>
   bool certifiedInfeasible(const MatC& C, const VecL& lower, const VecU& upper, int p, bool up,
                            const QpSettings& settings) {
@@ -304,7 +312,7 @@ class DualActiveSetQp {
     auto beta = [&](int j, bool upper_side) { return upper_side ? -upper(j) : lower(j); };
     z_.head(n) = (up ? -1.0 : 1.0) * C.row(p).head(n).transpose();  // ρ
     double gap = beta(p, up);
-    double slack = tol * (1.0 / rinv_(p) + std::abs(gap));
+    double slack = tol * (1.0 / rinv_(p) + std::abs(gap)), ysum = 1.0 / rinv_(p);
     for (int k = 0; k < q_; ++k) {
       const int j = row_(k);
       const bool uk = upper_(k) != 0;
@@ -312,9 +320,10 @@ class DualActiveSetQp {
       z_.head(n) += (uk ? -y : y) * C.row(j).head(n).transpose();
       gap += y * b;
       slack += y * tol * (1.0 / rinv_(j) + std::abs(b));
+      ysum += y / rinv_(j);
     }
-    const double X = 1e3 * (1.0 + x_.norm() + x0_.norm());
-    return gap > slack + z_.head(n).norm() * X;
+    const double rho = z_.head(n).norm(), X = 1e3 * (1.0 + x_.norm() + x0_.norm());
+    return rho <= 1e-12 * ysum && gap > slack + rho * X;
   }
 
   // The final check before Optimal, O(m n + n² + q n): x finite, every row (both sides, active

@@ -180,6 +180,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
 
   const std::vector<DynLevel> L = levels(wbc);
   bool finite = true, inverted = false, impossible = false;
+  double crossing = 0.0;  // largest lower − upper on a unit row (printed with HQP_FUZZ_VERBOSE)
   for (const DynLevel& l : L) {
     finite = finite && l.A.allFinite() && l.b.allFinite() && l.D.allFinite() && !l.lower.hasNaN() && !l.upper.hasNaN();
     for (int r = 0; r < l.D.rows(); ++r) {
@@ -187,14 +188,17 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       // by more than feasibility_tol on the unit-norm row; a smaller crossing is a row
       // held at (lower + upper) / 2 within the tolerance, as every solver treats it.
       const double nrm = l.D.row(r).norm();
-      inverted = inverted || (l.lower(r) - l.upper(r)) / (nrm > 1e-300 ? nrm : 1.0) > hqp::QpSettings{}.feasibility_tol;
+      const double cross = (l.lower(r) - l.upper(r)) / (nrm > 1e-300 ? nrm : 1.0);
+      crossing = std::max(crossing, cross);
+      inverted = inverted || cross > hqp::QpSettings{}.feasibility_tol;
       impossible = impossible || l.lower(r) == hqp::fuzz::kInf || l.upper(r) == -hqp::fuzz::kInf;
     }
   }
   const QpStatus s = wbc.solve();
   const auto& res = wbc.result();
   if (std::getenv("HQP_FUZZ_VERBOSE")) {
-    std::fprintf(stderr, "finite %d inverted %d impossible %d status %s\n", finite, inverted, impossible, hqp::toString(s));
+    std::fprintf(stderr, "finite %d inverted %d (largest crossing %.3g on a unit row) impossible %d status %s\n", finite,
+                 inverted, crossing, impossible, hqp::toString(s));
     for (int p = 0; p < 4; ++p)
       std::fprintf(stderr, "level %d: %s residual %.17g dropped %d dual %d\n", p, hqp::toString(res.levels[p].status),
                    res.levels[p].residual, res.levels[p].constraints_dropped, res.levels[p].dual);
