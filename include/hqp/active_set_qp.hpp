@@ -1067,12 +1067,13 @@ bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::phase1Certified() {
   // n x ≥ β with y ≥ 0 turns this into Σ y n = ρ ≈ 0 and gap = Σ y β = −Σ λ_k rhs_k: any x
   // meeting each row to its tolerance τ_k = feasibility_tol (1 + |rhs_k|) has
   // ρᵀx − gap ≥ −Σ |λ_k| τ_k, impossible for ‖x‖ ≤ X (far beyond the iterates) if
-  // gap > Σ |λ_k| τ_k + ‖ρ‖ X. ρ must be rounding (‖ρ‖ ≤ 1e-12 Σ |λ_k|): a larger one means the
+  // gap > Σ |λ_k| τ_k + ‖ρ‖ X, X = feasibility_tol / ε · (1 + max |rhs_k|): beyond X no row value
+  // can be computed to the tolerance in double precision. ρ must be rounding (‖ρ‖ ≤ 1e-12 Σ |λ_k|): a larger one means the
   // rows are only nearly dependent, and a feasible point may lie far out (|x| ~ gap / ‖ρ‖).
   // Rows with a wrong-signed μ are left out (then in ρ).
   const double tol = settings_.feasibility_tol;
   d_.head(n_).setZero();  // ρ
-  double gap = 0.0, slack = 0.0, ysum = 0.0;
+  double gap = 0.0, slack = 0.0, ysum = 0.0, bmax = 0.0;
   for (int i = 0; i < k_; ++i) {
     const double l = lam_(i);
     if (i >= neq_) {
@@ -1086,8 +1087,10 @@ bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::phase1Certified() {
     gap -= l * rhs_(i);
     slack += std::abs(l) * tol * (1.0 + std::abs(rhs_(i)));
     ysum += std::abs(l);
+    bmax = std::max(bmax, std::abs(rhs_(i)));
   }
-  const double rho = d_.head(n_).norm(), X = 1e3 * (1.0 + xc_.head(n_).norm());
+  const double rho = d_.head(n_).norm();
+  const double X = tol / std::numeric_limits<double>::epsilon() * (1.0 + bmax);
   return rho <= 1e-12 * ysum && gap > slack + rho * X;
 }
 

@@ -301,7 +301,8 @@ class DualActiveSetQp {
   // with r = r_ ≤ 0, each row written n x ≥ β (n = c at lower, −c at upper). With y = (1, −r)
   // ≥ 0, any x meeting every row to its tolerance τ = feasibility_tol (‖n‖ + |β|) satisfies
   // Σ y_k (n_k x − β_k) ≥ −Σ y_k τ_k, i.e. ρᵀx − gap ≥ −Σ y τ with ρ = Σ y n (rounding) and
-  // gap = Σ y β. No x with ‖x‖ ≤ X (far beyond the iterates) exists if gap exceeds both; ρ
+  // gap = Σ y β. No x with ‖x‖ ≤ X = feasibility_tol / ε · (1 + max |β̂|) exists if gap exceeds
+  // both (beyond X no row value can be computed to the tolerance in double precision); ρ
   // must be rounding (‖ρ‖ ≤ 1e-12 Σ y ‖n‖), else the rows are only nearly dependent and a
   // feasible point may lie far out.
   template <class MatC, class VecL, class VecU>
@@ -313,6 +314,7 @@ class DualActiveSetQp {
     z_.head(n) = (up ? -1.0 : 1.0) * C.row(p).head(n).transpose();  // ρ
     double gap = beta(p, up);
     double slack = tol * (1.0 / rinv_(p) + std::abs(gap)), ysum = 1.0 / rinv_(p);
+    double bmax = std::abs(gap) * rinv_(p);
     for (int k = 0; k < q_; ++k) {
       const int j = row_(k);
       const bool uk = upper_(k) != 0;
@@ -321,13 +323,15 @@ class DualActiveSetQp {
       gap += y * b;
       slack += y * tol * (1.0 / rinv_(j) + std::abs(b));
       ysum += y / rinv_(j);
+      bmax = std::max(bmax, std::abs(b) * rinv_(j));
     }
-    const double rho = z_.head(n).norm(), X = 1e3 * (1.0 + x_.norm() + x0_.norm());
+    const double rho = z_.head(n).norm();
+    const double X = tol / std::numeric_limits<double>::epsilon() * (1.0 + bmax);
     return rho <= 1e-12 * ysum && gap > slack + rho * X;
   }
 
   // The final check before Optimal, O(m n + n² + q n): x finite, every row (both sides, active
-  // rows included) within feasibility_tol · (1 + |ĉ x|), and the stationarity residual
+  // rows included) within feasibility_tol · (1 + |ĉ x|), active rows that close to their bound, and the stationarity residual
   // RᵀR x − Rᵀ(Q_Aᵀ b) + Σ ±u_k c_k = Aᵀ(A x − b) + Σ ±u_k c_k at rounding level relative to
   // its terms. Rounding with a nearly singular A shows up here rather than as a wrong Optimal.
   template <class MatC, class VecL, class VecU>
@@ -341,6 +345,13 @@ class DualActiveSetQp {
       const double t = settings.feasibility_tol * (1.0 + std::abs(v));
       if (!((lower(j) * rinv_(j) - v) <= t) || !((v - upper(j) * rinv_(j)) <= t))
         return QpStatus::NumericalFailure;
+    }
+    // Active rows at their bounds (complementarity): a nearly singular active set blows the
+    // multipliers up (1e30) and x far out, where an "active" row ends up off its bound.
+    for (int k = 0; k < q_; ++k) {
+      const int j = row_(k);
+      const double v = cx_(j) * rinv_(j), bnd = (upper_(k) ? upper(j) : lower(j)) * rinv_(j);
+      if (!(std::abs(v - bnd) <= settings.feasibility_tol * (1.0 + std::abs(v)))) return QpStatus::NumericalFailure;
     }
     // g = Rᵀ(R x − c), R upper triangular in F_.
     const auto R = F_.topLeftCorner(n, n).template triangularView<Eigen::Upper>();

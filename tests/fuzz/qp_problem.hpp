@@ -177,6 +177,23 @@ inline void checkKkt(const QpProblem& p, const Eigen::VectorXd& x, const Eigen::
     HQP_FUZZ_CHECK2(std::abs(g(j)) <= 1e-7 * (scale(j) + scale.maxCoeff() + normwise) + 1e-12, g(j), scale(j));
 }
 
+// A point so far out that no row value can be computed to the tolerance in double precision
+// (docs/hqp.md, "Contracts": ‖x‖ > feasibility_tol / ε · (1 + max |bound| on unit rows)) is no
+// witness of feasibility: the solvers may call such a problem Infeasible.
+inline bool beyondVerifiable(const QpProblem& p, const Eigen::VectorXd& x) {
+  double bmax = 0.0;
+  for (int i = 0; i < p.C.rows(); ++i) {
+    const double nrm = p.C.row(i).norm(), s = nrm > 0.0 ? nrm : 1.0;
+    for (double b : {p.lower(i), p.upper(i)})
+      if (std::isfinite(b)) bmax = std::max(bmax, std::abs(b) / s);
+  }
+  for (int i = 0; i < p.E.rows(); ++i) {
+    const double nrm = p.E.row(i).norm();
+    bmax = std::max(bmax, std::abs(p.e(i)) / (nrm > 0.0 ? nrm : 1.0));
+  }
+  return x.norm() > 1e-9 / std::numeric_limits<double>::epsilon() * (1.0 + bmax);
+}
+
 inline double objective(const QpProblem& p, const Eigen::VectorXd& x) {
   return 0.5 * (p.A * x - p.b).squaredNorm();
 }

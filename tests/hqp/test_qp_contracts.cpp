@@ -604,4 +604,33 @@ TEST(QpContracts, ActiveSetNeverInfeasibleWithAFeasiblePointFarOut) {
   }
 }
 
+// dual_qp_optimal_active_row_off_bound: rows 0 and 2 at an angle of 1e-11, both active, blew
+// the multipliers up to 2e30 and x out to 6e14, where active row 7 was 0.46 off its bound;
+// the stationarity check, scaled by those multipliers, let it through as Optimal. An Optimal
+// answer must hold its active rows at their bounds (and meet every row).
+TEST(QpContracts, DualOptimalHoldsItsActiveRowsAtTheirBounds) {
+  Eigen::MatrixXd A(5, 5), C(8, 5);
+  A << 4.625, -2.2588335205203034, 0, 10.375, 3.125, 4.6937227658920548, -1.7871433644818691, 5.375,
+      -1.1890077928205436, -5.071144449047603, -12.375, 0, 9, -0.02790603440986841, 6, 10.875, -14.625,
+      4.9764403442750211, -9.2941176470588243, -9.2941144399865436, -9.625, -14.875, -9.2941176470588243,
+      -9.2941176470588243, -9.2941176470588243;
+  Eigen::VectorXd b(5), lo(8), up(8);
+  b << -9.2941176470588243, -9.2941176470588243, -9.2941176470588243, -9.2941176470588243, -9.2941166197952718;
+  C << -9.2941176468951152, -9.2941176470588243, -9.2941176470588243, -9.294117647058755, 0, 0, 0, 0, 0, -14.875,
+      -9.2941176470588225, -9.2941176470588243, -9.2941176470588243, -9.2941176470588243, -9.2941176470588243, 10,
+      0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 11.875, 0, -9.839966288745286e-05;
+  lo << 0, 70.091371920222585, -32, -32, -32, -32, -32, -32;
+  up << 6.1941349662762075, kInf, 0, 0, 0, 0, 0, 0;
+  hqp::DualActiveSetQp<5, 5, 8> qp;
+  ASSERT_TRUE(qp.factorize(A, b, 5, 5, 1e-9));
+  const hqp::QpStatus s = qp.solve(C, lo, up, 8, hqp::QpSettings{});
+  if (s != hqp::QpStatus::Optimal) return;  // NumericalFailure is the honest answer here
+  EXPECT_LE(violation(C, lo, up, qp.x(), 1e-9), 1e-9);
+  for (int k = 0; k < qp.numActive(); ++k) {
+    const int j = qp.activeRow(k);
+    const double v = C.row(j).dot(qp.x()), bound = qp.activeAtUpper(k) ? up(j) : lo(j);
+    EXPECT_LE(std::abs(v - bound) / C.row(j).norm(), 1e-9 * (1.0 + std::abs(v) / C.row(j).norm())) << j;
+  }
+}
+
 }  // namespace
