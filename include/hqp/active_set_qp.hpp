@@ -188,6 +188,7 @@ class ActiveSetQp {
   }
   bool subproblem();                   // xs_ = optimum on the working set
   bool phase1Certified();              // phase 1's multipliers prove infeasibility (Farkas)
+  bool equalitiesCertified();          // a dependent equality contradicts the others
   bool multipliers();                  // lam_ for K at x = xs_ (needs y_ from subproblem())
   QpStatus iterate(bool phase1);       // the active-set loop on the current phase
   double maxViolation(const VecN& v);  // scaled, over E and C (uses ev_, cx_)
@@ -1095,6 +1096,40 @@ bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::phase1Certified() {
 }
 
 template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::equalitiesCertified() {
+  // After addEqualities() found a dependent row inconsistent: row i = Kᵀβ + ρ with β = R⁻¹ (Qᵀ ê_i)(0:k)
+  // (Kᵀ = Q₁ R). E x = e then forces ê_i x = βᵀ rhs + ρᵀx; it contradicts e_i (the same bound as
+  // phase1Certified) only if |e_i − βᵀ rhs| > tol (1 + |e_i| + Σ |β_k| (1 + |rhs_k|)) + ‖ρ‖ X.
+  // Rows only 1e-10 apart (huge β) are not certified: NumericalFailure instead of Infeasible.
+  const double tol = settings_.feasibility_tol;
+  for (int i = 0; i < me_; ++i) {
+    if (eq_indep_(i)) continue;
+    for (int c = 0; c < n_; ++c) a_(c) = Es_(i, c);
+    if (nv_ > n_) a_(n_) = 0.0;
+    if (qexplicit_) {
+      w_.head(nv_).noalias() = Q_.topLeftCorner(nv_, nv_).transpose() * a_.head(nv_);
+    } else {
+      w_.head(nv_) = a_.head(nv_);
+      for (int j = 0; j < k_; ++j) applyReflector(j, w_);
+    }
+    const double rho = w_.segment(k_, nv_ - k_).norm();
+    for (int j = k_ - 1; j >= 0; --j) {  // β = R⁻¹ w(0:k), in place
+      w_(j) /= R_(j, j);
+      w_.head(j) -= w_(j) * R_.col(j).head(j);
+    }
+    double gap = es_(i), slack = tol * (1.0 + std::abs(es_(i))), bmax = std::abs(es_(i));
+    for (int j = 0; j < k_; ++j) {
+      gap -= w_(j) * rhs_(j);
+      slack += std::abs(w_(j)) * tol * (1.0 + std::abs(rhs_(j)));
+      bmax = std::max(bmax, std::abs(rhs_(j)));
+    }
+    const double X = tol / std::numeric_limits<double>::epsilon() * (1.0 + bmax);
+    if (std::isfinite(gap) && std::abs(gap) > slack + rho * X) return true;
+  }
+  return false;
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
 void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::finish(QpStatus s) {
   status_ = s;
   objective_ = 0.0;
@@ -1157,7 +1192,7 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::solveOnce(const VectorX* x_
   nw_ = 0;
   if (!addEqualities()) {
     x_.setZero(n_);
-    finish(QpStatus::Infeasible);
+    finish(equalitiesCertified() ? QpStatus::Infeasible : QpStatus::NumericalFailure);
     return status_;
   }
   bool started = false;

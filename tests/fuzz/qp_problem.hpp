@@ -200,8 +200,8 @@ inline double objective(const QpProblem& p, const Eigen::VectorXd& x) {
 
 // Lower bound on the objective at any point y from a KKT point x with multipliers (λ, μ),
 // by convexity: f(y) ≥ f(x) + ∇f(x)ᵀ(y − x), and with ∇f(x) = −Eᵀλ − Σ ±μ c + s (s the
-// stationarity residual), ∇f(x)ᵀ(y − x) ≥ −Σ μ viol_k(y) − |λ|ᵀ|E y − e| − ‖s‖ ‖y − x‖,
-// viol_k(y) ≥ 0 how far y is outside row k's active bound. Two answers that are each feasible
+// stationarity residual), ∇f(x)ᵀ(y − x) ≥ −Σ μ (viol_k(y) + |c_k x − b_k|) − |λ|ᵀ|E (y − x)|
+// − ‖s‖ ‖y − x‖, viol_k(y) ≥ 0 how far y is outside row k's active bound b_k. Two answers that are each feasible
 // to the tolerance can differ in objective by this much, no more: with (nearly) parallel rows
 // the multipliers are huge and the tolerance-wide feasible set much larger than the exact one.
 inline double lagrangianBound(const QpProblem& p, const Eigen::VectorXd& x, const Eigen::VectorXd& lambda,
@@ -210,7 +210,7 @@ inline double lagrangianBound(const QpProblem& p, const Eigen::VectorXd& x, cons
   double bound = objective(p, x);
   if (lambda.size() > 0) {
     s += p.E.transpose() * lambda;
-    bound -= lambda.cwiseAbs().dot((p.E * y - p.e).cwiseAbs());
+    bound -= lambda.cwiseAbs().dot((p.E * (y - x)).cwiseAbs());
   }
   for (const ActiveRow& a : active) {
     const Eigen::VectorXd r = p.C.row(a.row).transpose();
@@ -222,6 +222,8 @@ inline double lagrangianBound(const QpProblem& p, const Eigen::VectorXd& x, cons
     // multipliers of 2e15 on two nearly parallel equality rows turn into ~1e3).
     const double b = a.upper ? p.upper(a.row) : p.lower(a.row);
     bound -= std::abs(a.mu) * 1e-14 * (r.cwiseAbs().dot(y.cwiseAbs()) + r.cwiseAbs().dot(x.cwiseAbs()) + std::abs(b));
+    // x's own row off its bound (within the tolerance) shifts the bound by μ |c x − b|.
+    bound -= std::abs(a.mu) * std::abs(r.dot(x) - b);
   }
   return bound - s.norm() * (y - x).norm();
 }

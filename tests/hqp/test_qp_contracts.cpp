@@ -633,4 +633,42 @@ TEST(QpContracts, DualOptimalHoldsItsActiveRowsAtTheirBounds) {
   }
 }
 
+// active_set_qp_infeasible_nearly_dependent_equalities: three equality rows, the second 4.5e-10
+// from the first, the third a multiple of x₁ mostly: x = (−16 / 7.33…, 0) meets all three.
+// The third was found dependent on the first two, whose nearly singular pair put the
+// minimum-norm point 1e-6 off it, and ActiveSetQp said Infeasible without a certificate.
+TEST(QpContracts, ActiveSetNeverInfeasibleWithNearlyDependentEqualities) {
+  Eigen::MatrixXd A(4, 2), E(3, 2);
+  A << -5, -12.625, 7.3333333333333339, 7.3333333333333339, 7.3333333333333339, 7.3333333333333339,
+      7.3333333333333339, 7.3333333333333339;
+  Eigen::VectorXd b(4), e = Eigen::VectorXd::Constant(3, -16.0);
+  b << 0, -7.875, -9.9999989985686475e-05, -16;
+  E << 7.3333333333333339, 7.3333333333333339, 7.3333333333333339, 7.3333333300409631, 7.3333333333333339,
+      7333.3333300459371;
+  const Eigen::Vector2d xw(-16.0 / 7.3333333333333339, 0.0);
+  for (int i = 0; i < 3; ++i) ASSERT_LE(std::abs(E.row(i).dot(xw) - e(i)) / E.row(i).norm(), 1e-15) << i;
+  hqp::ActiveSetQp<2, 4, 3, 1> qp;
+  qp.resize(2, 4, 3, 0);
+  qp.A() = A;
+  qp.b() = b;
+  qp.E() = E;
+  qp.e() = e;
+  const hqp::QpStatus s = qp.solve(false);
+  EXPECT_NE(s, hqp::QpStatus::Infeasible);
+  if (s == hqp::QpStatus::Optimal) {
+    for (int i = 0; i < 3; ++i) {
+      const double v = E.row(i).dot(qp.x()) / E.row(i).norm();
+      EXPECT_LE(std::abs(v - e(i) / E.row(i).norm()), 1e-9 * (1.0 + std::abs(v))) << i;
+    }
+  }
+  // Contradicting equalities are still Infeasible: x₀ + x₁ = 1 twice, then = 2.
+  Eigen::MatrixXd E2(3, 2);
+  E2 << 1, 1, 2, 2, 1, 1;
+  Eigen::VectorXd e2(3);
+  e2 << 1, 2, 2;
+  qp.E() = E2;
+  qp.e() = e2;
+  EXPECT_EQ(str(qp.solve(false)), "Infeasible");
+}
+
 }  // namespace
