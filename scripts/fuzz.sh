@@ -6,7 +6,7 @@
 #   scripts/fuzz.sh --ci          the CI regression: the fixed seed corpus, then a fixed-seed
 #                                 mutation run of a fixed number of inputs per fuzzer (the same
 #                                 inputs on every machine, ~20 s each on the 2-core CI machine),
-#                                 with the known findings skipped (HQP_FUZZ_SKIP_KNOWN=1)
+#                                 with the saved findings of tests/fuzz/findings in the corpus
 # Exit code 1 if any fuzzer reported a finding. Work folder: $HQP_FUZZ_DIR (default build-fuzz/run).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -38,10 +38,19 @@ for f in "${fuzzers[@]}"; do
     rm -rf "$dir/corpus" && mkdir -p "$dir/corpus"
   fi
   python3 "$root/tests/fuzz/make_seeds.py" "$f" "$dir/corpus" 300
+  if [ $ci -eq 1 ]; then
+    # Every saved finding is replayed by the fuzzer(s) that decode it (docs/fuzzing.md).
+    case "$f" in
+      fuzz_active_set_qp|fuzz_dual_qp) pat='active_set_qp_* dual_*' ;;
+      fuzz_hqp) pat='hqp_*' ;; fuzz_urdf_generator) pat='urdf_generator_*' ;; *) pat='' ;;
+    esac
+    for p in $pat; do
+      for file in "$root"/tests/fuzz/findings/$p; do [ -f "$file" ] && cp "$file" "$dir/corpus/finding_$(basename "$file")"; done
+    done
+  fi
   opts=(-artifact_prefix="$dir/artifacts/" -print_final_stats=1 -max_len=4096)
   [ "$f" = fuzz_urdf_generator ] && opts+=(-dict="$root/tests/fuzz/urdf.dict")
   if [ $ci -eq 1 ]; then
-    export HQP_FUZZ_SKIP_KNOWN=1
     # Deterministic: a count of runs, not a wall time (a slower machine must not reach other inputs).
     case "$f" in
       fuzz_active_set_qp) runs=800 ;; fuzz_dual_qp) runs=20000 ;; fuzz_hqp) runs=400 ;;

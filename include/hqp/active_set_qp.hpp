@@ -187,6 +187,8 @@ class ActiveSetQp {
     return j >= 0 && j < mi_ && !in_ws_(j) && std::abs(up ? us_(j) : ls_(j)) < kInf;
   }
   bool subproblem();                   // xs_ = optimum on the working set
+  bool phase1Certified();              // phase 1's multipliers prove infeasibility (Farkas)
+  bool equalitiesCertified();          // a dependent equality contradicts the others
   bool multipliers();                  // lam_ for K at x = xs_ (needs y_ from subproblem())
   QpStatus iterate(bool phase1);       // the active-set loop on the current phase
   double maxViolation(const VecN& v);  // scaled, over E and C (uses ev_, cx_)
@@ -1060,6 +1062,74 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
 }
 
 template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::phase1Certified() {
+  // At phase 1's optimum Kᵀλ = −(0, t): the x part gives Σ λ_k k_k = 0 over the working set
+  // (unit rows k_k, right-hand sides rhs_k, inequality rows with μ ≥ 0). Every row written
+  // n x ≥ β with y ≥ 0 turns this into Σ y n = ρ ≈ 0 and gap = Σ y β = −Σ λ_k rhs_k: any x
+  // meeting each row to its tolerance τ_k = feasibility_tol (1 + |rhs_k|) has
+  // ρᵀx − gap ≥ −Σ |λ_k| τ_k, impossible for ‖x‖ ≤ X (far beyond the iterates) if
+  // gap > Σ |λ_k| τ_k + ‖ρ‖ X, X = feasibility_tol / ε · (1 + max |rhs_k|): beyond X no row value
+  // can be computed to the tolerance in double precision. ρ must be rounding (‖ρ‖ ≤ 1e-12 Σ |λ_k|): a larger one means the
+  // rows are only nearly dependent, and a feasible point may lie far out (|x| ~ gap / ‖ρ‖).
+  // Rows with a wrong-signed μ are left out (then in ρ).
+  const double tol = settings_.feasibility_tol;
+  d_.head(n_).setZero();  // ρ
+  double gap = 0.0, slack = 0.0, ysum = 0.0, bmax = 0.0;
+  for (int i = 0; i < k_; ++i) {
+    const double l = lam_(i);
+    if (i >= neq_) {
+      const int w = i - neq_, j = ws_row_(w);
+      const double mu = ws_upper_(w) ? l : -l;
+      if (ls_(j) != us_(j) && mu < 0.0) continue;
+      d_.head(n_) -= l * Cs_.row(j).head(n_).transpose();
+    } else {
+      d_.head(n_) -= l * Es_.row(eq_pos_(i)).head(n_).transpose();
+    }
+    gap -= l * rhs_(i);
+    slack += std::abs(l) * tol * (1.0 + std::abs(rhs_(i)));
+    ysum += std::abs(l);
+    bmax = std::max(bmax, std::abs(rhs_(i)));
+  }
+  const double rho = d_.head(n_).norm();
+  const double X = tol / std::numeric_limits<double>::epsilon() * (1.0 + bmax);
+  return rho <= 1e-12 * ysum && gap > slack + rho * X;
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::equalitiesCertified() {
+  // After addEqualities() found a dependent row inconsistent: row i = Kᵀβ + ρ with β = R⁻¹ (Qᵀ ê_i)(0:k)
+  // (Kᵀ = Q₁ R). E x = e then forces ê_i x = βᵀ rhs + ρᵀx; it contradicts e_i (the same bound as
+  // phase1Certified) only if |e_i − βᵀ rhs| > tol (1 + |e_i| + Σ |β_k| (1 + |rhs_k|)) + ‖ρ‖ X.
+  // Rows only 1e-10 apart (huge β) are not certified: NumericalFailure instead of Infeasible.
+  const double tol = settings_.feasibility_tol;
+  for (int i = 0; i < me_; ++i) {
+    if (eq_indep_(i)) continue;
+    for (int c = 0; c < n_; ++c) a_(c) = Es_(i, c);
+    if (nv_ > n_) a_(n_) = 0.0;
+    if (qexplicit_) {
+      w_.head(nv_).noalias() = Q_.topLeftCorner(nv_, nv_).transpose() * a_.head(nv_);
+    } else {
+      w_.head(nv_) = a_.head(nv_);
+      for (int j = 0; j < k_; ++j) applyReflector(j, w_);
+    }
+    const double rho = w_.segment(k_, nv_ - k_).norm();
+    for (int j = k_ - 1; j >= 0; --j) {  // β = R⁻¹ w(0:k), in place
+      w_(j) /= R_(j, j);
+      w_.head(j) -= w_(j) * R_.col(j).head(j);
+    }
+    double gap = es_(i), slack = tol * (1.0 + std::abs(es_(i))), bmax = std::abs(es_(i));
+    for (int j = 0; j < k_; ++j) {
+      gap -= w_(j) * rhs_(j);
+      slack += std::abs(w_(j)) * tol * (1.0 + std::abs(rhs_(j)));
+      bmax = std::max(bmax, std::abs(rhs_(j)));
+    }
+    const double X = tol / std::numeric_limits<double>::epsilon() * (1.0 + bmax);
+    if (std::isfinite(gap) && std::abs(gap) > slack + rho * X) return true;
+  }
+  return false;
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
 void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::finish(QpStatus s) {
   status_ = s;
   objective_ = 0.0;
@@ -1122,7 +1192,7 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::solveOnce(const VectorX* x_
   nw_ = 0;
   if (!addEqualities()) {
     x_.setZero(n_);
-    finish(QpStatus::Infeasible);
+    finish(equalitiesCertified() ? QpStatus::Infeasible : QpStatus::NumericalFailure);
     return status_;
   }
   bool started = false;
@@ -1169,9 +1239,11 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::solveOnce(const VectorX* x_
         return status_;
       }
       if (xc_(n_) > settings_.feasibility_tol) {
+        // Infeasible only with a checked certificate; a phase 1 stuck on (nearly) parallel
+        // rows whose multipliers are rounding noise is a numerical failure instead.
         x_.setZero(n_);
         nw_ = 0;
-        finish(QpStatus::Infeasible);
+        finish(phase1Certified() ? QpStatus::Infeasible : QpStatus::NumericalFailure);
         return status_;
       }
       startPhase(false);

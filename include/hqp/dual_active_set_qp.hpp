@@ -88,7 +88,13 @@ class DualActiveSetQp {
         for (int l = 0; l < i; ++l) x[l] -= xi * R[l];
       }
     }
-    const double jn2 = J_.topLeftCorner(n, n).squaredNorm();
+    // ‖R⁻¹‖_F² over the upper triangle (the rest is zero). Summed by hand: GCC's loop analysis
+    // of Eigen's block reduction at -O3 warned of an access past a MaxN-column matrix.
+    double jn2 = 0.0;
+    for (int j = 0; j < n; ++j) {
+      const double* x = &J_(0, j);
+      for (int i = 0; i <= j; ++i) jn2 += x[i] * x[i];
+    }
     if (!(jn2 < kInf) || !(jn2 * min_sigma * min_sigma < 1.0)) return false;
     x0_.noalias() = J_.topLeftCorner(n, n) * c_.head(n);  // R⁻¹ (Q_Aᵀ b)(0:n)
     factorized_ = x0_.allFinite();
@@ -111,6 +117,7 @@ class DualActiveSetQp {
                  int prefer_count = 0) noexcept {
     const int n = n_;
     q_ = 0;
+    held_ = 0;
     iterations_ = 0;
     if (!factorized_ || m < 0 || m > MaxIneq) {
       x_.setZero(n > 0 ? n : 0);
@@ -136,6 +143,7 @@ class DualActiveSetQp {
     }
     for (int k = 0; k < prefer_count; ++k)
       if (prefer[k] >= 0 && prefer[k] < m) prefer_(prefer[k]) = 1;
+    m_ = m;
     cx_.head(m).noalias() = C.topLeftCorner(m, n) * x_;
     for (;;) {
       // Step 1: the most violated row side (violation scaled to a unit-norm row).
@@ -177,7 +185,17 @@ class DualActiveSetQp {
         // n_p in the span of the active normals: no primal step (z = 0).
         const bool primal = dz2 > 1e-24 * d_.head(n).squaredNorm() && dz2 > 0.0;
         const double t2 = primal ? -s / dz2 : kInf;
-        if (drop < 0 && !primal) return QpStatus::Infeasible;
+        if (drop < 0 && !primal) {
+          // n_p = Σ r_k n_k with every r_k ≤ 0. Infeasible only if the bounds contradict by
+          // more than the tolerance (a checked Farkas certificate); otherwise the violation
+          // is rounding of a (nearly) duplicate row: the row is held by the active rows.
+          if (certifiedInfeasible(C, lower, upper, p, up, settings)) return QpStatus::Infeasible;
+          for (int k = 0; k < q_; ++k) u_(k) += uplus * r_(k);  // n_p's multiplier moves to them
+          if (uplus > 0.0 && (u_.head(q_).array() < 0.0).any()) return QpStatus::NumericalFailure;
+          active_(p) = 2;
+          ++held_;
+          break;
+        }
         const double t = t2 <= t1 ? t2 : t1;
         if (primal) {
           z_.head(n).noalias() = J_.block(0, q_, n, n - q_) * d_.segment(q_, n - q_);
@@ -253,6 +271,11 @@ class DualActiveSetQp {
   // Removes active row k: R_a loses column k, rotations restore the triangle (and turn J).
   void dropActive(int k) {
     active_(row_(k)) = 0;
+    if (held_ > 0) {  // rows held by the active set are free again
+      for (int j = 0; j < m_; ++j)
+        if (active_(j) == 2) active_(j) = 0;
+      held_ = 0;
+    }
     for (int j = k; j < q_ - 1; ++j) {
       Ra_.col(j).head(j + 2) = Ra_.col(j + 1).head(j + 2);
       row_(j) = row_(j + 1);
@@ -274,8 +297,41 @@ class DualActiveSetQp {
     }
   }
 
+  // Farkas check for a violated row p (side up) dependent on the active rows, n_p = Σ r_k n_k
+  // with r = r_ ≤ 0, each row written n x ≥ β (n = c at lower, −c at upper). With y = (1, −r)
+  // ≥ 0, any x meeting every row to its tolerance τ = feasibility_tol (‖n‖ + |β|) satisfies
+  // Σ y_k (n_k x − β_k) ≥ −Σ y_k τ_k, i.e. ρᵀx − gap ≥ −Σ y τ with ρ = Σ y n (rounding) and
+  // gap = Σ y β. No x with ‖x‖ ≤ X = feasibility_tol / ε · (1 + max |β̂|) exists if gap exceeds
+  // both (beyond X no row value can be computed to the tolerance in double precision); ρ
+  // must be rounding (‖ρ‖ ≤ 1e-12 Σ y ‖n‖), else the rows are only nearly dependent and a
+  // feasible point may lie far out.
+  template <class MatC, class VecL, class VecU>
+  bool certifiedInfeasible(const MatC& C, const VecL& lower, const VecU& upper, int p, bool up,
+                           const QpSettings& settings) {
+    const int n = n_;
+    const double tol = settings.feasibility_tol;
+    auto beta = [&](int j, bool upper_side) { return upper_side ? -upper(j) : lower(j); };
+    z_.head(n) = (up ? -1.0 : 1.0) * C.row(p).head(n).transpose();  // ρ
+    double gap = beta(p, up);
+    double slack = tol * (1.0 / rinv_(p) + std::abs(gap)), ysum = 1.0 / rinv_(p);
+    double bmax = std::abs(gap) * rinv_(p);
+    for (int k = 0; k < q_; ++k) {
+      const int j = row_(k);
+      const bool uk = upper_(k) != 0;
+      const double y = -r_(k), b = beta(j, uk);
+      z_.head(n) += (uk ? -y : y) * C.row(j).head(n).transpose();
+      gap += y * b;
+      slack += y * tol * (1.0 / rinv_(j) + std::abs(b));
+      ysum += y / rinv_(j);
+      bmax = std::max(bmax, std::abs(b) * rinv_(j));
+    }
+    const double rho = z_.head(n).norm();
+    const double X = tol / std::numeric_limits<double>::epsilon() * (1.0 + bmax);
+    return rho <= 1e-12 * ysum && gap > slack + rho * X;
+  }
+
   // The final check before Optimal, O(m n + n² + q n): x finite, every row (both sides, active
-  // rows included) within feasibility_tol · (1 + |ĉ x|), and the stationarity residual
+  // rows included) within feasibility_tol · (1 + |ĉ x|), active rows that close to their bound, and the stationarity residual
   // RᵀR x − Rᵀ(Q_Aᵀ b) + Σ ±u_k c_k = Aᵀ(A x − b) + Σ ±u_k c_k at rounding level relative to
   // its terms. Rounding with a nearly singular A shows up here rather than as a wrong Optimal.
   template <class MatC, class VecL, class VecU>
@@ -289,6 +345,13 @@ class DualActiveSetQp {
       const double t = settings.feasibility_tol * (1.0 + std::abs(v));
       if (!((lower(j) * rinv_(j) - v) <= t) || !((v - upper(j) * rinv_(j)) <= t))
         return QpStatus::NumericalFailure;
+    }
+    // Active rows at their bounds (complementarity): a nearly singular active set blows the
+    // multipliers up (1e30) and x far out, where an "active" row ends up off its bound.
+    for (int k = 0; k < q_; ++k) {
+      const int j = row_(k);
+      const double v = cx_(j) * rinv_(j), bnd = (upper_(k) ? upper(j) : lower(j)) * rinv_(j);
+      if (!(std::abs(v - bnd) <= settings.feasibility_tol * (1.0 + std::abs(v)))) return QpStatus::NumericalFailure;
     }
     // g = Rᵀ(R x − c), R upper triangular in F_.
     const auto R = F_.topLeftCorner(n, n).template triangularView<Eigen::Upper>();
@@ -310,7 +373,7 @@ class DualActiveSetQp {
   }
 
   bool factorized_ = false;
-  int n_ = 0, q_ = 0, iterations_ = 0;
+  int n_ = 0, m_ = 0, q_ = 0, held_ = 0, iterations_ = 0;
   Eigen::Matrix<double, MaxRows, MaxN> F_;   // QR of A (R on and above the diagonal)
   Eigen::Matrix<double, MaxRows, 1> c_;  // Q_Aᵀ b
   Eigen::Matrix<double, MaxN, MaxN> J_, Ra_;

@@ -1,6 +1,6 @@
 #pragma once
 // Shared by the libFuzzer harnesses of tests/fuzz (docs/fuzzing.md): decoding bytes into
-// numbers, the "known findings" switch, and a failure report that aborts (libFuzzer then
+// numbers and a failure report that aborts (libFuzzer then
 // saves the input as a crash-* file).
 
 #include <fuzzer/FuzzedDataProvider.h>
@@ -14,16 +14,6 @@ namespace hqp::fuzz {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-// HQP_FUZZ_SKIP_KNOWN=1: inputs of the classes listed as known findings in docs/fuzzing.md are
-// skipped (the CI regression run uses it, so that it stays green until those are fixed).
-inline bool skipKnown() {
-  static const bool skip = [] {
-    const char* s = std::getenv("HQP_FUZZ_SKIP_KNOWN");
-    return s != nullptr && s[0] == '1';
-  }();
-  return skip;
-}
 
 [[noreturn]] inline void fail(const char* what, double a = 0.0, double b = 0.0) {
   std::fprintf(stderr, "FUZZ FINDING: %s (%.17g, %.17g)\n", what, a, b);

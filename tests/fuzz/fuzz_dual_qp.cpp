@@ -21,17 +21,6 @@ constexpr int kN = 6, kRows = 9, kIneq = 8;
 using Dual = hqp::DualActiveSetQp<kN, kRows, kIneq>;
 using Primal = hqp::ActiveSetQp<kN, kRows, 1, kIneq>;
 
-// Two rows of C at an angle below ~1e-5 rad (or equal up to a factor).
-bool nearlyParallelRows(const Eigen::MatrixXd& C) {
-  for (int i = 0; i < C.rows(); ++i)
-    for (int j = 0; j < i; ++j) {
-      const double ni = C.row(i).norm(), nj = C.row(j).norm();
-      if (ni == 0.0 || nj == 0.0) continue;
-      if (std::abs(C.row(i).dot(C.row(j))) / (ni * nj) > 1.0 - 1e-10) return true;
-    }
-  return false;
-}
-
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -39,9 +28,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace hqp::fuzz;
   FuzzedDataProvider in(data, size);
   QpProblem p = decodeQp(in, kN, kRows, 0, kIneq, true);
-  // Known findings (docs/fuzzing.md): NaN data and bounds, lower > upper, lower = +inf or
-  // upper = −inf are not refused by DualActiveSetQp.
-  if (skipKnown() && !p.validInput()) return -1;
   const int n = static_cast<int>(p.A.cols()), r = static_cast<int>(p.A.rows()), m = static_cast<int>(p.C.rows());
   const double min_sigma = 1e-9;
   static Dual dual;
@@ -101,38 +87,37 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const Eigen::JacobiSVD<Eigen::MatrixXd> svd(p.A);
   const double kappa = svd.singularValues()(0) / svd.singularValues()(n - 1);
   const bool conditioned = kappa <= 1e7;
+  std::vector<ActiveRow> pactive;
+  for (int k = 0; k < primal.numActive(); ++k)
+    pactive.push_back({primal.activeRow(k), primal.activeAtUpper(k), primal.multiplier(k)});
   if (sp == QpStatus::Optimal && conditioned) {  // the reference's own answer, checked the same way
-    std::vector<ActiveRow> active;
-    for (int k = 0; k < primal.numActive(); ++k)
-      active.push_back({primal.activeRow(k), primal.activeAtUpper(k), primal.multiplier(k)});
     checkFeasible(p, primal.x());
-    checkKkt(p, primal.x(), Eigen::VectorXd(), active);
+    checkKkt(p, primal.x(), Eigen::VectorXd(), pactive);
   }
   if (s == QpStatus::Optimal) {
     const Eigen::VectorXd x = dual.x().head(n);
-    // Known finding (docs/fuzzing.md): with κ(A) > 1e7 the answer can violate a row by ~1e-5
-    // (the final feasibility test uses the incrementally updated C x).
-    if (skipKnown() && !conditioned) return 0;
     checkFeasible(p, x);
     std::vector<ActiveRow> active;
     for (int k = 0; k < dual.numActive(); ++k) active.push_back({dual.activeRow(k), dual.activeAtUpper(k), dual.multiplier(k)});
     if (conditioned) checkKkt(p, x, Eigen::VectorXd(), active);
-    // The primal method must not call a problem with a feasible point infeasible (known
-    // finding with (nearly) parallel rows, as for the dual method).
-    HQP_FUZZ_CHECK(sp != QpStatus::Infeasible || (skipKnown() && nearlyParallelRows(p.C)));
-    // Known finding: with (nearly) parallel constraint rows the two methods can stop at
-    // different objectives, both within the KKT tolerances (huge opposing multipliers).
-    if (sp == QpStatus::Optimal && conditioned && !(skipKnown() && nearlyParallelRows(p.C))) {
-      const double f = objective(p, x), fp = objective(p, primal.x());
-      HQP_FUZZ_CHECK2(std::abs(f - fp) <= 1e-6 * (1.0 + f + fp + 0.5 * p.b.squaredNorm()), f, fp);
+    // The primal method must not call a problem with a feasible point infeasible (unless the
+    // point lies beyond where feasibility can be verified in double precision).
+    HQP_FUZZ_CHECK(sp != QpStatus::Infeasible || beyondVerifiable(p, x));
+    // The optimum of a strictly convex QP is unique, but both answers are only feasible to the
+    // tolerance: each objective is at least the other's Lagrangian bound (qp_problem.hpp).
+    if (sp == QpStatus::Optimal && conditioned) {
+      const Eigen::VectorXd xp = primal.x();
+      const double f = objective(p, x), fp = objective(p, xp);
+      const double tol = 1e-6 * (1.0 + f + fp + 0.5 * p.b.squaredNorm());
+      const Eigen::VectorXd none;
+      HQP_FUZZ_CHECK2(f >= lagrangianBound(p, xp, none, pactive, x) - tol, f, fp);
+      HQP_FUZZ_CHECK2(fp >= lagrangianBound(p, x, none, active, xp) - tol, fp, f);
     }
   } else if (s == QpStatus::Infeasible) {
-    // Known finding (docs/fuzzing.md): with two (nearly) parallel or duplicate constraint rows
-    // the dual method can stop with Infeasible on a feasible problem (HqpWbc then falls back
-    // to ActiveSetQp).
-    if (skipKnown() && nearlyParallelRows(p.C)) return 0;
+    // Only with a certificate: never for a problem built around a feasible point, and the
+    // primal method finds no feasible point either.
     HQP_FUZZ_CHECK(!p.by_construction);
-    if (sp == QpStatus::Optimal) {
+    if (sp == QpStatus::Optimal && !beyondVerifiable(p, primal.x())) {
       // The primal answer, checked independently, is a feasible point: the dual answer is wrong.
       checkFeasible(p, primal.x());
       fail("DualActiveSetQp: Infeasible, but ActiveSetQp found a feasible point");

@@ -3,8 +3,8 @@
 // scenes drawn from the input (docs/fuzzing.md). The first bytes seed the synthetic scene, the
 // rest overwrite single entries of any task or constraint (±inf and NaN included).
 // Checks, independent of HqpWbc's null-space cascade:
-//  - input outside the contract (non-finite data, NaN bounds, lower > upper, lower = +inf,
-//    upper = −inf) is never Optimal;
+//  - input outside the contract (non-finite data, NaN bounds, lower > upper by more than the
+//    feasibility tolerance, lower = +inf, upper = −inf) is never Optimal;
 //  - Optimal: x satisfies every constraint that was not dropped, and each level p, solved
 //    alone in the full 30 variables by a fresh ActiveSetQp with the higher levels' task values
 //    A_k x = A_k x* (k < p) as equalities and the constraints of levels ≤ p, reaches the same
@@ -180,19 +180,25 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
 
   const std::vector<DynLevel> L = levels(wbc);
   bool finite = true, inverted = false, impossible = false;
+  double crossing = 0.0;  // largest lower − upper on a unit row (printed with HQP_FUZZ_VERBOSE)
   for (const DynLevel& l : L) {
     finite = finite && l.A.allFinite() && l.b.allFinite() && l.D.allFinite() && !l.lower.hasNaN() && !l.upper.hasNaN();
     for (int r = 0; r < l.D.rows(); ++r) {
-      inverted = inverted || l.lower(r) > l.upper(r);
+      // The documented rule (docs/hqp.md, "Contracts"): a row is empty when its bounds cross
+      // by more than feasibility_tol on the unit-norm row; a smaller crossing is a row
+      // held at (lower + upper) / 2 within the tolerance, as every solver treats it.
+      const double nrm = l.D.row(r).norm();
+      const double cross = (l.lower(r) - l.upper(r)) / (nrm > 1e-300 ? nrm : 1.0);
+      crossing = std::max(crossing, cross);
+      inverted = inverted || cross > hqp::QpSettings{}.feasibility_tol;
       impossible = impossible || l.lower(r) == hqp::fuzz::kInf || l.upper(r) == -hqp::fuzz::kInf;
     }
   }
-  // Known finding (docs/fuzzing.md): a row with lower = +inf or upper = −inf is ignored.
-  if (hqp::fuzz::skipKnown() && impossible) return -1;
   const QpStatus s = wbc.solve();
   const auto& res = wbc.result();
   if (std::getenv("HQP_FUZZ_VERBOSE")) {
-    std::fprintf(stderr, "finite %d inverted %d impossible %d status %s\n", finite, inverted, impossible, hqp::toString(s));
+    std::fprintf(stderr, "finite %d inverted %d (largest crossing %.3g on a unit row) impossible %d status %s\n", finite,
+                 inverted, crossing, impossible, hqp::toString(s));
     for (int p = 0; p < 4; ++p)
       std::fprintf(stderr, "level %d: %s residual %.17g dropped %d dual %d\n", p, hqp::toString(res.levels[p].status),
                    res.levels[p].residual, res.levels[p].constraints_dropped, res.levels[p].dual);

@@ -19,7 +19,7 @@ struct QpProblem {
   Eigen::MatrixXd A, E, C;
   Eigen::VectorXd b, e, lower, upper;
   bool finite_data = true;      // A, b, E, e, C finite and no NaN bound
-  bool inverted_bounds = false;  // some lower > upper (empty row)
+  bool inverted_bounds = false;  // some lower > upper beyond the tolerance (empty row)
   bool impossible_inf = false;   // some lower = +inf or upper = −inf (a row no x can meet)
   bool by_construction = false;  // bounds and e built around a point x0: feasible
   Eigen::VectorXd x0;
@@ -99,7 +99,11 @@ inline QpProblem decodeQp(FuzzedDataProvider& in, int n_max, int m_max, int me_m
   p.finite_data = p.A.allFinite() && p.b.allFinite() && p.E.allFinite() && p.e.allFinite() &&
                   p.C.allFinite() && !p.lower.hasNaN() && !p.upper.hasNaN();
   for (int i = 0; i < mi; ++i) {
-    p.inverted_bounds = p.inverted_bounds || p.lower(i) > p.upper(i);
+    // The solvers' rule (docs/hqp.md, "Contracts"): empty only if the bounds cross by more
+    // than feasibility_tol on the unit-norm row (zero rows unscaled); a smaller crossing is a
+    // row held within the tolerance.
+    const double nrm = p.C.row(i).norm();
+    p.inverted_bounds = p.inverted_bounds || (p.lower(i) - p.upper(i)) / (nrm > 0.0 ? nrm : 1.0) > 1e-9;
     p.impossible_inf = p.impossible_inf || p.lower(i) == kInf || p.upper(i) == -kInf;
   }
   p.by_construction = p.by_construction && p.finite_data && !p.inverted_bounds && !p.impossible_inf &&
@@ -173,8 +177,55 @@ inline void checkKkt(const QpProblem& p, const Eigen::VectorXd& x, const Eigen::
     HQP_FUZZ_CHECK2(std::abs(g(j)) <= 1e-7 * (scale(j) + scale.maxCoeff() + normwise) + 1e-12, g(j), scale(j));
 }
 
+// A point so far out that no row value can be computed to the tolerance in double precision
+// (docs/hqp.md, "Contracts": ‖x‖ > feasibility_tol / ε · (1 + max |bound| on unit rows)) is no
+// witness of feasibility: the solvers may call such a problem Infeasible.
+inline bool beyondVerifiable(const QpProblem& p, const Eigen::VectorXd& x) {
+  double bmax = 0.0;
+  for (int i = 0; i < p.C.rows(); ++i) {
+    const double nrm = p.C.row(i).norm(), s = nrm > 0.0 ? nrm : 1.0;
+    for (double b : {p.lower(i), p.upper(i)})
+      if (std::isfinite(b)) bmax = std::max(bmax, std::abs(b) / s);
+  }
+  for (int i = 0; i < p.E.rows(); ++i) {
+    const double nrm = p.E.row(i).norm();
+    bmax = std::max(bmax, std::abs(p.e(i)) / (nrm > 0.0 ? nrm : 1.0));
+  }
+  return x.norm() > 1e-9 / std::numeric_limits<double>::epsilon() * (1.0 + bmax);
+}
+
 inline double objective(const QpProblem& p, const Eigen::VectorXd& x) {
   return 0.5 * (p.A * x - p.b).squaredNorm();
+}
+
+// Lower bound on the objective at any point y from a KKT point x with multipliers (λ, μ),
+// by convexity: f(y) ≥ f(x) + ∇f(x)ᵀ(y − x), and with ∇f(x) = −Eᵀλ − Σ ±μ c + s (s the
+// stationarity residual), ∇f(x)ᵀ(y − x) ≥ −Σ μ (viol_k(y) + |c_k x − b_k|) − |λ|ᵀ|E (y − x)|
+// − ‖s‖ ‖y − x‖, viol_k(y) ≥ 0 how far y is outside row k's active bound b_k. Two answers that are each feasible
+// to the tolerance can differ in objective by this much, no more: with (nearly) parallel rows
+// the multipliers are huge and the tolerance-wide feasible set much larger than the exact one.
+inline double lagrangianBound(const QpProblem& p, const Eigen::VectorXd& x, const Eigen::VectorXd& lambda,
+                              const std::vector<ActiveRow>& active, const Eigen::VectorXd& y) {
+  Eigen::VectorXd s = p.A.transpose() * (p.A * x - p.b);
+  double bound = objective(p, x);
+  if (lambda.size() > 0) {
+    s += p.E.transpose() * lambda;
+    bound -= lambda.cwiseAbs().dot((p.E * (y - x)).cwiseAbs());
+  }
+  for (const ActiveRow& a : active) {
+    const Eigen::VectorXd r = p.C.row(a.row).transpose();
+    s += (a.upper ? a.mu : -a.mu) * r;
+    const double cy = r.dot(y);
+    const double viol = a.upper ? cy - p.upper(a.row) : p.lower(a.row) - cy;
+    bound -= a.mu >= 0.0 ? a.mu * std::max(viol, 0.0) : -a.mu * std::abs(viol);
+    // viol itself carries the rounding of c y and c x (at a row value of 2715 ~5e-13, which
+    // multipliers of 2e15 on two nearly parallel equality rows turn into ~1e3).
+    const double b = a.upper ? p.upper(a.row) : p.lower(a.row);
+    bound -= std::abs(a.mu) * 1e-14 * (r.cwiseAbs().dot(y.cwiseAbs()) + r.cwiseAbs().dot(x.cwiseAbs()) + std::abs(b));
+    // x's own row off its bound (within the tolerance) shifts the bound by μ |c x − b|.
+    bound -= std::abs(a.mu) * std::abs(r.dot(x) - b);
+  }
+  return bound - s.norm() * (y - x).norm();
 }
 
 }  // namespace hqp::fuzz

@@ -22,6 +22,7 @@
 
 #include "gen_fixed_arm_model.hpp"
 #include "gen_fused_pair_frames_model.hpp"
+#include "gen_fused_heavy_light_model.hpp"
 #include "gen_fused_pair_model.hpp"
 #include "urdf_reference.hpp"
 #ifdef HQP_HAVE_WALKER3
@@ -124,7 +125,10 @@ INSTANTIATE_TEST_SUITE_P(
         // Text from the file is escaped: the message stays one line.
         BadCase{"bad_multiline_attribute.urdf", "link 'base': <inertia iyy='0.01\\n  kg'> is not a number"},
         BadCase{"bad_urdfdom_multiline.urdf", "urdfdom: Unable to parse component [0.5\\n]"},
-        BadCase{"bad_inertial_overflow.urdf", "link 'thigh': <inertial> lies so far from the body origin"},
+        BadCase{"bad_inertial_overflow.urdf", "link 'thigh': <origin xyz='0.5e200 0 0'> is outside ±1000 m"},
+        BadCase{"bad_joint_origin_too_far.urdf", "joint 'hip': <origin xyz='0 0 -1500'> is outside ±1000 m"},
+        BadCase{"bad_huge_mass.urdf", "link 'l0': mass 2.93799e+15 kg is above 1e+06 kg"},
+        BadCase{"bad_huge_inertia.urdf", "link 'thigh': <inertia ixx='2e6'> is outside ±1e+06 kg m²"},
         BadCase{"bad_lower_above_upper.urdf", "joint 'knee': <limit lower='1'> is above <limit upper='-1'>"},
         // Caught by urdfdom only: its own message, after the file name.
         BadCase{"bad_urdfdom_safety.urdf", "urdfdom: joint safety: no k_velocity"}),
@@ -362,6 +366,25 @@ TEST(Fusion, RotatedChildAndRotatedInertialGiveTheClosedForm) {
   EXPECT_EQ(arm.friction, 0.7);
   EXPECT_EQ(fused_pair::Robot::bodies[0].mass, 4.0);
   EXPECT_EQ(fused_pair::Robot::total_mass, 7.0);
+}
+
+// A heavy and a light link fused far from the body origin (tests/data/fused_heavy_light.urdf):
+// summing both about the origin and shifting back lost the light link's inertia to rounding
+// (a negative principal moment for a 2.9e15 kg link). Closed form as above: m = m1 + m2,
+// I = I1 + I2 + mu (|r|^2 E - r r^T), r = c2 - c1 = (0, -1, 0), mu = m1 m2 / m.
+TEST(Fusion, HeavyAndLightLinkFarOutGiveTheClosedForm) {
+  const auto& b = fused_heavy_light::Robot::bodies[1];
+  const double m1 = 1e6, m2 = 1.0, m = m1 + m2, mu = m1 * m2 / m;
+  EXPECT_EQ(b.mass, m);
+  EXPECT_NEAR(b.com[0], 1000.0, 1e-12);
+  EXPECT_NEAR(b.com[1], 1000.0 - m2 / m, 1e-12);
+  EXPECT_NEAR(b.com[2], 1000.0, 1e-12);
+  const double small = 2e-4, big = 2e-4 + mu;   // yy is along r: only the two own inertias
+  const double tol = 1e-9 * small;
+  EXPECT_NEAR(b.inertia[0], big, 1e-9 * big);
+  EXPECT_NEAR(b.inertia[1], small, tol);
+  EXPECT_NEAR(b.inertia[2], big, 1e-9 * big);
+  for (int k = 3; k < 6; ++k) EXPECT_NEAR(b.inertia[k], 0.0, tol) << k;
 }
 
 TEST(Frames, OnlyTheListedOnesBesidesTheBodies) {

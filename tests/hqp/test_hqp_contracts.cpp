@@ -237,4 +237,27 @@ TEST(HqpContracts, NaNIsInvalidInput) {
   EXPECT_TRUE(wqp.x().allFinite());
 }
 
+// Bounds that cross by less than feasibility_tol on the unit-norm row are one value within the
+// tolerance, not an empty row (the rule of every solver, docs/hqp.md "Contracts"; the fuzzer's
+// hqp_optimal_with_inverted_row crossed by 4.3e-11). Level 0's row 2 x₂ ∈ [l, 3]: crossed by
+// half the tolerance it holds x₂ at 1.5 (level 1 wants 1); crossed by four times the
+// tolerance it is empty and dropped, and x₂ = 1.
+TEST(HqpContracts, BoundsCrossedWithinTheToleranceAreHeld) {
+  static Wbc wbc;
+  fillBase(wbc);
+  const double tol = hqp::QpSettings{}.feasibility_tol;
+  auto& c0 = wbc.level<0>().constraint<0>();
+  c0.D << 0, 0, 2, 0;  // ‖d‖ = 2
+  c0.upper << 3.0;
+  c0.lower << 3.0 + 0.5 * tol * 2.0;
+  ASSERT_EQ(wbc.solve(), hqp::QpStatus::Optimal);
+  EXPECT_FALSE(wbc.result().levels[0].constraints_dropped);
+  EXPECT_NEAR(wbc.x()(2), 1.5, tol * (1.0 + 1.5));
+  c0.lower << 3.0 + 4.0 * tol * 2.0;
+  EXPECT_EQ(wbc.solve(), hqp::QpStatus::Infeasible);
+  EXPECT_EQ(wbc.result().failed_level, 0);
+  EXPECT_TRUE(wbc.result().levels[0].constraints_dropped);
+  EXPECT_NEAR(wbc.x()(2), 1.0, 1e-12);
+}
+
 }  // namespace

@@ -95,11 +95,16 @@ inline BruteForceResult bruteForceQp(const Eigen::MatrixXd& A, const Eigen::Vect
       }
     }
     const Eigen::VectorXd cx = C * x;
+    const Eigen::VectorXd cax = C.cwiseAbs() * x.cwiseAbs();
     for (Eigen::Index j = 0; j < mi; ++j) {
       const double nrm = C.row(j).norm();
       const double s = nrm > 0.0 ? nrm : 1.0;
-      if (lower(j) > -inf && (lower(j) - cx(j)) / s > feas_tol) return false;
-      if (upper(j) < inf && (cx(j) - upper(j)) / s > feas_tol) return false;
+      // The solvers' rule, feas_tol (1 + |ĉ x|) on a unit row, plus the rounding of c x
+      // itself: an optimum far out (|x| ~ 1e7 on a direction C does not see) is
+      // otherwise rejected for rounding noise and the enumeration misses it.
+      const double tol = feas_tol * (1.0 + std::abs(cx(j)) / s) + 1e-14 * cax(j) / s;
+      if (lower(j) > -inf && (lower(j) - cx(j)) / s > tol) return false;
+      if (upper(j) < inf && (cx(j) - upper(j)) / s > tol) return false;
     }
     return true;
   };

@@ -98,11 +98,14 @@ inline void collectGroup(const RawRobot& r, const std::string& link, const Trans
   }
 }
 
-// Checks one link's <inertial> and adds it to the body's mass, first moment and
-// inertia about the body origin (eq. for the parallel-axis theorem:
-// I_O = I_C + m (|c|^2 E - c c^T)).
-inline void addLinkInertia(const RawLink& raw, const Transform& T, double& mass,
-                           Eigen::Vector3d& first_moment, Eigen::Matrix3d& I_origin) {
+// Checks one link's <inertial> and adds it to the body's list of point masses: mass, CoM
+// and rotated inertia about that CoM, in the body frame.
+struct LinkMass {
+  double mass;
+  Eigen::Vector3d com;
+  Eigen::Matrix3d inertia;
+};
+inline void addLinkInertia(const RawLink& raw, const Transform& T, std::vector<LinkMass>& parts) {
   if (!raw.has_inertial) return;   // massless (sensor frames and the like)
   struct {
     double mass, ixx, iyy, izz, ixy, ixz, iyz;
@@ -134,23 +137,23 @@ inline void addLinkInertia(const RawLink& raw, const Transform& T, double& mass,
                                   show(e(2)) + ")");
   }
   const Transform Ti = T * originTransform(raw.inertial_xyz, raw.inertial_rpy);
-  const Eigen::Vector3d c = Ti.p;
   const Eigen::Matrix3d Ib = Ti.R * I * Ti.R.transpose();   // I_body = R I R^T
-  const Eigen::Matrix3d I_shift = Ib + in.mass * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
-  if (!c.allFinite() || !I_shift.allFinite()) {
+  if (!Ti.p.allFinite() || !Ib.allFinite()) {
     throw linkError(raw.name, "<inertial> lies so far from the body origin that its inertia overflows");
   }
-  mass += in.mass;
-  first_moment += in.mass * c;
-  I_origin += I_shift;
+  parts.push_back({in.mass, Ti.p, Ib});
 }
 
 inline void setInertia(const RawRobot& r, const Group& g, Body& b) {
+  std::vector<LinkMass> parts;
+  for (const auto& [name, T] : g.links) {
+    addLinkInertia(r.links[r.link_index.at(name)], T, parts);
+  }
   double m = 0;
   Eigen::Vector3d h = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d I0 = Eigen::Matrix3d::Zero();
-  for (const auto& [name, T] : g.links) {
-    addLinkInertia(r.links[r.link_index.at(name)], T, m, h, I0);
+  for (const LinkMass& l : parts) {
+    m += l.mass;
+    h += l.mass * l.com;
   }
   if (m <= 0) {
     const std::string why = b.joint.empty() ? "it is the floating base"
@@ -159,11 +162,23 @@ inline void setInertia(const RawRobot& r, const Group& g, Body& b) {
   }
   b.mass = m;
   b.com = h / m;
-  // Back from the body origin to the CoM (parallel-axis theorem).
-  b.inertia = I0 - m * (b.com.squaredNorm() * Eigen::Matrix3d::Identity() - b.com * b.com.transpose());
+  // Each link shifted straight to the body's CoM (parallel-axis theorem): a sum of positive
+  // semi-definite terms. Shifting to the body origin and back subtracts two large numbers,
+  // which lost a light link's inertia next to a heavy one and left a negative eigenvalue.
+  b.inertia.setZero();
+  for (const LinkMass& l : parts) {
+    const Eigen::Vector3d d = l.com - b.com;
+    b.inertia += l.inertia + l.mass * (d.squaredNorm() * Eigen::Matrix3d::Identity() - d * d.transpose());
+  }
   b.inertia = 0.5 * (b.inertia + b.inertia.transpose()).eval();
   if (!b.com.allFinite() || !b.inertia.allFinite()) {
     throw linkError(b.link, "the body's CoM or inertia overflows (links fixed to it lie too far apart)");
+  }
+  // Safety net for the contract of docs/generated-model.md (rounding of the sums above).
+  const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(b.inertia, Eigen::EigenvaluesOnly).eigenvalues();
+  if (!(ev(0) >= -1e-12 * ev(2))) {
+    throw linkError(b.link, "the inertia of the links fused into this body is not positive semi-definite (principal moment " +
+                                show(ev(0)) + "): masses or distances too far apart");
   }
 }
 

@@ -24,6 +24,12 @@ namespace hqp::tools {
 
 using Vec3 = std::array<double, 3>;
 
+// Accepted magnitudes (docs/generated-model.md). A robot's numbers lie far inside them; beyond
+// them the parallel-axis sums of fused links lose the small inertias to rounding.
+constexpr double kMaxMass = 1e6;      // kg, per link
+constexpr double kMaxInertia = 1e6;   // kg m², per <inertia> entry
+constexpr double kMaxLength = 1e3;    // m, per <origin xyz> entry
+
 struct RawLink {
   std::string name;
   bool has_inertial = false;
@@ -81,6 +87,11 @@ inline void readOrigin(const TiXmlElement* parent, Vec3& xyz, Vec3& rpy,
   };
   if (const char* s = o->Attribute("xyz")) {
     if (!parseVec3(s, xyz)) throw fail("xyz", s);
+    for (double v : xyz)
+      if (!(std::abs(v) <= kMaxLength)) {
+        const std::string what = "<origin xyz=" + quote(s) + "> is outside ±" + show(kMaxLength) + " m";
+        throw owner_kind == "joint" ? jointError(owner, what) : linkError(owner, what);
+      }
   }
   if (const char* s = o->Attribute("rpy")) {
     if (!parseVec3(s, rpy)) throw fail("rpy", s);
@@ -145,6 +156,7 @@ inline RawRobot scanUrdf(const std::string& xml) {
       detail::readNumber(mass, "value", l.mass, true, fail);
       // Checked here for every link, also those fused into a fixed base (whose inertia is dropped).
       if (!std::isfinite(l.mass) || l.mass < 0) throw fail("negative or invalid mass " + show(l.mass));
+      if (l.mass > kMaxMass) throw fail("mass " + show(l.mass) + " kg is above " + show(kMaxMass) + " kg");
       const TiXmlElement* I = in->FirstChildElement("inertia");
       if (I == nullptr) throw fail("<inertial> has no <inertia>");
       detail::readNumber(I, "ixx", l.ixx, true, fail);
@@ -153,6 +165,12 @@ inline RawRobot scanUrdf(const std::string& xml) {
       detail::readNumber(I, "ixy", l.ixy, true, fail);
       detail::readNumber(I, "ixz", l.ixz, true, fail);
       detail::readNumber(I, "iyz", l.iyz, true, fail);
+      const char* names[] = {"ixx", "iyy", "izz", "ixy", "ixz", "iyz"};
+      const double values[] = {l.ixx, l.iyy, l.izz, l.ixy, l.ixz, l.iyz};
+      for (int k = 0; k < 6; ++k)
+        if (!(std::abs(values[k]) <= kMaxInertia))
+          throw fail("<inertia " + std::string(names[k]) + "=" + quote(I->Attribute(names[k])) + "> is outside ±" +
+                     show(kMaxInertia) + " kg m²");
     }
     r.link_index[l.name] = static_cast<int>(r.links.size());
     r.links.push_back(l);
