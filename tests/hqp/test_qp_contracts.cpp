@@ -37,13 +37,26 @@ double violation(const Eigen::MatrixXd& C, const Eigen::VectorXd& lo, const Eige
 // Largest violation of lower ≤ C x ≤ upper, rows scaled to unit norm.
 double violation(const Eigen::MatrixXd& C, const Eigen::VectorXd& lo, const Eigen::VectorXd& up,
                  const Eigen::VectorXd& x) {
-  double v = 0.0;
-  const Eigen::VectorXd cx = C * x;
-  for (Eigen::Index j = 0; j < C.rows(); ++j) {
-    const double s = std::max(C.row(j).norm(), 1e-300);
-    v = std::max(v, std::max(lo(j) - cx(j), cx(j) - up(j)) / s);
+  return violation(C, lo, up, x, 0.0);
+}
+
+// A problem with a feasible point (checked by the caller): ActiveSetQp must not call it
+// Infeasible, and an Optimal answer meets every row (rounding of large row values aside).
+template <int N, int M, int E, int I>
+void expectNotInfeasible(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const Eigen::MatrixXd& C,
+                         const Eigen::VectorXd& lo, const Eigen::VectorXd& up) {
+  hqp::ActiveSetQp<N, M, E, I> qp;
+  qp.resize(N, M, E, I);
+  qp.A() = A;
+  qp.b() = b;
+  qp.C() = C;
+  qp.lower() = lo;
+  qp.upper() = up;
+  const hqp::QpStatus s = qp.solve(false);
+  EXPECT_NE(s, hqp::QpStatus::Infeasible);
+  if (s == hqp::QpStatus::Optimal) {
+    EXPECT_LE(violation(C, lo, up, qp.x(), 1e-9), 1e-9);
   }
-  return v;
 }
 
 using Dual2 = hqp::DualActiveSetQp<2, 2, 2>;
@@ -480,18 +493,7 @@ TEST(QpContracts, ActiveSetNeverInfeasibleWhenFeasibleToTheTolerance) {
   K << C.row(3), C.row(1);
   const Eigen::Vector2d xt = K.fullPivLu().solve(Eigen::Vector2d(lo(3), lo(1)));
   ASSERT_LE(violation(C, lo, up, xt), 1e-9);
-  hqp::ActiveSetQp<2, 7, 0, 8> qp;
-  qp.resize(2, 7, 0, 8);
-  qp.A() = A;
-  qp.b() = b;
-  qp.C() = C;
-  qp.lower() = lo;
-  qp.upper() = up;
-  const hqp::QpStatus s = qp.solve(false);
-  EXPECT_NE(s, hqp::QpStatus::Infeasible);
-  if (s == hqp::QpStatus::Optimal) {
-    EXPECT_LE(violation(C, lo, up, qp.x(), 1e-9), 1e-9);
-  }
+  expectNotInfeasible<2, 7, 0, 8>(A, b, C, lo, up);
 }
 
 // active_set_qp_objective_below_enumeration: C does not see the direction (0, 1, −1, 0) and A
@@ -590,18 +592,7 @@ TEST(QpContracts, ActiveSetNeverInfeasibleWithAFeasiblePointFarOut) {
   xw(2) = (-16.0 - C(3, 3) * xw(3)) / C(3, 2);
   ASSERT_GT(xw.cwiseAbs().maxCoeff(), 1e9);
   ASSERT_LE(violation(C, lo, up, xw, 1e-9), 1e-9);
-  hqp::ActiveSetQp<4, 6, 0, 5> qp;
-  qp.resize(4, 6, 0, 5);
-  qp.A() = A;
-  qp.b() = b;
-  qp.C() = C;
-  qp.lower() = lo;
-  qp.upper() = up;
-  const hqp::QpStatus s = qp.solve(false);
-  EXPECT_NE(s, hqp::QpStatus::Infeasible);
-  if (s == hqp::QpStatus::Optimal) {
-    EXPECT_LE(violation(C, lo, up, qp.x(), 1e-9), 1e-9);
-  }
+  expectNotInfeasible<4, 6, 0, 5>(A, b, C, lo, up);
 }
 
 // dual_qp_optimal_active_row_off_bound: rows 0 and 2 at an angle of 1e-11, both active, blew
