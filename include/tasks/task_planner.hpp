@@ -188,10 +188,8 @@ class TaskPlanner {
   }
 
   bool insideSafeRegion(const Eigen::Vector2d& zmp) const {
-    const double m = params_.safe_margin;
-    // A NaN ZMP compares false and so is outside.
-    return zmp.x() >= params_.sole_x_min + m && zmp.x() <= params_.sole_x_max - m &&
-           zmp.y() >= params_.sole_y_min + m && zmp.y() <= params_.sole_y_max - m;
+    return insideBand(zmp.x(), params_.sole_x_min, params_.sole_x_max) &&
+           insideBand(zmp.y(), params_.sole_y_min, params_.sole_y_max);
   }
 
   template <class Dyn>
