@@ -91,7 +91,13 @@ Simulation::Simulation(const SimulationOptions& options) : options_(options), rn
     sole_rect_[c] = {centre - half, centre + half};
   }
   applyModelPerturbation();
+  explicit_damping_.assign(m_->dof_damping, m_->dof_damping + m_->nv);
+  for (int i = 0; i < m_->nv; ++i) m_->dof_damping[i] = 0.0;
   reset();
+}
+
+void Simulation::applyDamping() {
+  for (int i = 0; i < m_->nv; ++i) d_->qfrc_applied[i] = -explicit_damping_[i] * d_->qvel[i];
 }
 
 void Simulation::applyModelPerturbation() {
@@ -357,6 +363,7 @@ void Simulation::step() {
     }
   }
   for (int k = 0; k < options_.substeps; ++k) {
+    applyDamping();
     mj_step(m_, d_);
     addDeliveredTorque();
     if (ball_flying_) {
@@ -371,6 +378,7 @@ void Simulation::step() {
   }
   delivered_ /= options_.substeps;
   // mj_step leaves sensordata of the state before its integration: refresh it for the new state.
+  applyDamping();
   mj_forward(m_, d_);
 }
 
@@ -441,7 +449,7 @@ int Simulation::supportActuator(const std::string& name) const {
 void Simulation::setSupportTarget(int a, double q, double dq) {
   const int j = m_->actuator_trnid[2 * a];
   const double kp = m_->actuator_gainprm[mjNGAIN * a];
-  d_->ctrl[a] = q + m_->dof_damping[m_->jnt_dofadr[j]] / kp * dq;
+  d_->ctrl[a] = q + explicit_damping_[m_->jnt_dofadr[j]] / kp * dq;  // kp (q - q_a) + D (dq - q̇_a)
 }
 
 double Simulation::supportPosition(int a) const { return d_->qpos[m_->jnt_qposadr[m_->actuator_trnid[2 * a]]]; }
@@ -536,13 +544,13 @@ Eigen::Vector2d Simulation::copInSole(int c, const Vector6& ft, double min_fz) c
 }
 
 // After mj_step, d_ still holds the forces of the step just taken (only qpos, qvel moved on). The
-// plant's joints have no springs, so their passive torque is the damping alone, which Euler
-// integrates implicitly: -D q̇ at the step's end velocity. A frictionloss row's Jacobian is the unit
-// vector of its dof, so its efc_force is the joint torque directly.
+// plant's joints have no springs; their damping is the explicit qfrc_applied of the step. A
+// frictionloss row's Jacobian is the unit vector of its dof, so its efc_force is the joint torque
+// directly.
 void Simulation::addDeliveredTorque() {
   for (int i = 0; i < kJoints; ++i) {
     const int dof = dofadr_[i];
-    delivered_[i] += d_->qfrc_actuator[dof] - m_->dof_damping[dof] * d_->qvel[dof];
+    delivered_[i] += d_->qfrc_actuator[dof] + d_->qfrc_applied[dof];
   }
   for (int r = 0; r < d_->nefc; ++r) {
     if (d_->efc_type[r] != mjCNSTR_FRICTION_DOF) continue;

@@ -12,6 +12,7 @@
 #include <array>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "plant_config.hpp"
 #include "plant_perturbation.hpp"
@@ -74,8 +75,8 @@ class Simulation {
 
   // Moving supports (seesaw, skateboards; scene <position> actuators on one-DoF joints, found by
   // name; throws if there is none). The servo force is kp (ctrl - q) - damping q̇ (the joint's
-  // implicit damping), so ctrl = q* + (damping / kp) q̇* makes it kp (q* - q) + damping (q̇* - q̇):
-  // position servo with velocity feed-forward.
+  // damping, applied explicitly), so ctrl = q* + (damping / kp) q̇* makes it
+  // kp (q* - q) + damping (q̇* - q̇): position servo with velocity feed-forward.
   int supportActuator(const std::string& name) const;
   void setSupportTarget(int actuator, double q, double dq);
   double supportPosition(int actuator) const;  // the servo joint's position (m or rad)
@@ -90,6 +91,8 @@ class Simulation {
   const VectorJ& standingPose() const { return q_stand_; }
   int jointQposAdr(int i) const { return qadr_[i]; }   // model joint i -> qpos index
   int jointDofAdr(int i) const { return dofadr_[i]; }  // model joint i -> qvel index
+  // Viscous damping of model joint i (N·m·s/rad), applied explicitly (explicit_damping_ below).
+  double jointDamping(int i) const { return explicit_damping_[static_cast<std::size_t>(dofadr_[i])]; }
   int actuator(int i) const { return act_[i]; }        // model joint i -> actuator id
   int baseQposAdr() const { return base_qadr_; }       // free joint: position, quaternion w x y z
   int baseDofAdr() const { return base_dofadr_; }      // free joint: linear (world), angular (body)
@@ -128,14 +131,16 @@ class Simulation {
   Vector6 wrenchInSole(int c, const Vector6& ft) const;
   // Joint torque the plant delivered to the links during the last step() (N·m, mean over the
   // substeps; zero after reset()): the actuator torque minus the joint's friction, i.e. the viscous
-  // damping at the step's end velocity (Euler integrates it implicitly) and the frictionloss
-  // constraint force (efc_force of the dof's friction row). What the controller's τ_opt asks for.
+  // damping at the step's start velocity (applied explicitly, see explicit_damping_) and the
+  // frictionloss constraint force (efc_force of the dof's friction row). What the controller's
+  // τ_opt asks for.
   const VectorJ& deliveredTorque() const { return delivered_; }
 
  private:
   int sensorAdr(const std::string& name, int dim) const;
   void addDeliveredTorque();  // one physics step's share of deliveredTorque()
   void applyModelPerturbation();
+  void applyDamping();  // qfrc_applied = -D q̇ for every dof (explicit_damping_)
   void addNoise(Sensors& s);  // payload, masses, friction, contacts (constructor)
 
   SimulationOptions options_;
@@ -153,6 +158,13 @@ class Simulation {
   std::array<std::array<Eigen::Vector2d, 2>, kContacts> sole_rect_;
   std::mt19937 rng_;
   VectorJ delivered_ = VectorJ::Zero();  // deliveredTorque()
+  // The scene's joint damping D per dof, moved out of the model (dof_damping = 0) and applied as
+  // qfrc_applied = -D q̇ before each step. MuJoCo 2.2's Euler integrates dof_damping implicitly
+  // after the constraint solve, which changes the damped dofs' accelerations but not the contact
+  // forces: a sole on a damped board then slips in proportion to the board's velocity (6.8 mm on
+  // skate_x at 0.96 m/s, whatever the noslip iterations). Applied explicitly, the damping is part
+  // of the forces the contacts are solved with (stable: h D / m <= 0.62 for the boards).
+  std::vector<double> explicit_damping_;
   Eigen::Vector3d gyro_bias_ = Eigen::Vector3d::Zero(), accel_bias_ = Eigen::Vector3d::Zero();  // IMU frame
   VectorJ k_t_plant_;                    // k_t_ with the torque-constant errors (what the motors have)
   std::vector<Sensors> sensor_history_;  // ring of the last readings (latency), newest at sensor_head_

@@ -87,8 +87,8 @@ TEST(SimDeliveredTorque, EqualsTheRigidBodyTorqueInFreeFall) {
       double rigid = ref->qfrc_bias[dof];
       for (int v = 0; v < m->nv; ++v) rigid += M[static_cast<std::size_t>(dof * m->nv + v)] * (d->qvel[v] - v0[v]) / h;
       EXPECT_NEAR(delivered[i], rigid, 1e-7) << jointName(i) << " at tick " << k;
-      // Friction the joint took: actuator minus delivered minus the damping at the end velocity.
-      const double friction = d->actuator_force[sim.actuator(i)] - m->dof_damping[dof] * d->qvel[dof] - delivered[i];
+      // Friction the joint took: actuator minus delivered minus the damping at the start velocity.
+      const double friction = d->actuator_force[sim.actuator(i)] - sim.jointDamping(i) * v0[dof] - delivered[i];
       max_friction = std::max(max_friction, std::abs(friction));
       if (std::abs(d->qvel[dof]) < 1e-4) ++stuck;
       else ++sliding;

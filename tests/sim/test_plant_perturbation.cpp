@@ -126,7 +126,9 @@ TEST(PlantPerturbation, MassScalesPerLinkAndForAll) {
   Simulation light(options(all));
   EXPECT_NEAR(robotMass(light.model()), 0.9 * robotMass(a), 1e-9);
   const int ball = mj_name2id(a, mjOBJ_BODY, "ball");
-  if (ball >= 0) EXPECT_EQ(light.model()->body_mass[ball], a->body_mass[ball]) << "the ball is not the robot";
+  if (ball >= 0) {
+    EXPECT_EQ(light.model()->body_mass[ball], a->body_mass[ball]) << "the ball is not the robot";
+  }
 }
 
 // Each sensor group reads what the unperturbed plant read that many ticks earlier (same
@@ -197,7 +199,8 @@ TEST(PlantPerturbation, ForceTorqueOffsetsFrictionAndContacts) {
   for (int i = 0; i < kJoints; ++i) {
     const YAML::Node j = plant["joints"][std::string(Robot::bodies[i + 1].joint).substr(2)];
     EXPECT_NEAR(sim.model()->dof_frictionloss[sim.jointDofAdr(i)], 1.3 * j["coulomb"].as<double>(), 1e-12);
-    EXPECT_NEAR(sim.model()->dof_damping[sim.jointDofAdr(i)], 1.3 * j["viscous"].as<double>(), 1e-12);
+    EXPECT_NEAR(sim.jointDamping(i), 1.3 * j["viscous"].as<double>(), 1e-12);
+    EXPECT_EQ(sim.model()->dof_damping[sim.jointDofAdr(i)], 0.0) << "damping is applied explicitly";
   }
   for (int g = 0; g < sim.model()->ngeom; ++g) EXPECT_EQ(sim.model()->geom_friction[3 * g], 0.4);
 }
