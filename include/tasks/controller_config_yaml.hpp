@@ -238,7 +238,8 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
     const std::string p = "planner";
     const YAML::Node n = r.map(root, "", p, {"safe_margin", "com_height", "sole", "torso_yaw_offset",
                                             "follow_acceleration_cutoff", "follow_translation", "hold_tipping_axis",
-                                            "com_reference_cutoff", "support_acceleration_from_estimator"});
+                                            "com_reference_cutoff", "support_acceleration_from_estimator",
+                                            "follow_acceleration_order", "follow_acceleration_deadband"});
     PlannerParameters& pl = c.planner;
     pl.safe_margin = r.atLeast(n, p, "safe_margin", 0.0, false);
     pl.com_height = r.finite(n, p, "com_height");
@@ -257,6 +258,17 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
       pl.support_acceleration_from_estimator = r.boolean(n, p, "support_acceleration_from_estimator");
     if (n["com_reference_cutoff"])
       pl.com_reference_cutoff = r.atLeast(n, p, "com_reference_cutoff", 0.0, false);
+    if (n["follow_acceleration_order"]) {
+      const double o = r.atLeast(n, p, "follow_acceleration_order", 1.0, false);
+      if (!(o == 1.0 || o == 2.0)) r.fail("'planner.follow_acceleration_order' must be 1 or 2");
+      pl.follow_acceleration_order = static_cast<int>(o);
+    }
+    if (n["follow_acceleration_deadband"]) {
+      const std::string q = p + ".follow_acceleration_deadband";
+      const YAML::Node d = r.map(n, p, "follow_acceleration_deadband", {"linear", "angular"});
+      pl.follow_acceleration_deadband_linear = r.atLeast(d, q, "linear", 0.0, false);
+      pl.follow_acceleration_deadband_angular = r.atLeast(d, q, "angular", 0.0, false);
+    }
   }
   {
     const std::string p = "estimator";

@@ -25,6 +25,7 @@
 //     support that moves steadily is still followed, with the filter's lag.
 // Allocation-free and exception-free; see docs/tasks.md.
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -49,6 +50,15 @@ struct PlannerParameters {
   // Hz, cutoff of the first-order low-pass on the finite difference of a foot's measured
   // velocity that feeds a following foot's acceleration reference; 0 = no feed-forward (paper).
   double follow_acceleration_cutoff = 0.0;
+  // Cascaded first-order stages of that low-pass (1 or 2). The finite difference turns white
+  // velocity noise σ_v into noise of σ_v / dt; one stage passes it with gain ~2π f_c, two roll it
+  // off (a third of the noise at 20 Hz, measured in docs/tasks.md).
+  int follow_acceleration_order = 1;
+  // Soft deadband on the filtered acceleration (linear m/s², angular rad/s²), per component:
+  // a_ff = sign(a) max(|a| − d, 0). What encoder noise leaves after the filter is taken off, so a
+  // foot on a still support gets no feed-forward (the paper's rule) and a moving one most of it.
+  double follow_acceleration_deadband_linear = 0.0;
+  double follow_acceleration_deadband_angular = 0.0;
   // A foot whose ZMP left the safe region holds only its orientation; its translation follows.
   bool follow_translation = false;
   // With follow_translation: hold the orientation only about the axis the foot can tip over,
@@ -86,7 +96,9 @@ class TaskPlanner {
     have_velocity_.fill(false);
     for (int c = 0; c < NC; ++c) {
       velocity_[c].setZero();
+      stage_[c].setZero();
       acceleration_[c].setZero();
+      feed_forward_[c].setZero();
     }
   }
 
@@ -102,24 +114,32 @@ class TaskPlanner {
     for (int c = 0; c < NC; ++c) {
       const Vector6 v = dyn.velocity(c);
       if (alpha_ > 0.0) {  // a_F ≈ low-pass((v_k − v_{k−1}) / dt); the first tick has no difference
-        if (have_velocity_[c]) acceleration_[c] += alpha_ * ((v - velocity_[c]) / dt_ - acceleration_[c]);
+        if (have_velocity_[c]) {
+          stage_[c] += alpha_ * ((v - velocity_[c]) / dt_ - stage_[c]);
+          acceleration_[c] = params_.follow_acceleration_order >= 2
+                                 ? Vector6(acceleration_[c] + alpha_ * (stage_[c] - acceleration_[c]))
+                                 : stage_[c];
+          feed_forward_[c] = acceleration_[c];
+          shrink(feed_forward_[c].template head<3>(), params_.follow_acceleration_deadband_linear);
+          shrink(feed_forward_[c].template tail<3>(), params_.follow_acceleration_deadband_angular);
+        }
         velocity_[c] = v;
         have_velocity_[c] = true;
         if (params_.support_acceleration_from_estimator && support_acceleration != nullptr)
-          acceleration_[c].template head<3>() = (*support_acceleration)[c];
+          feed_forward_[c].template head<3>() = (*support_acceleration)[c];
       }
       safe_[c] = in_contact[c] && insideSafeRegion(cop[c]);
       refs.contact_acceleration[c].setZero();
       if (safe_[c]) {
         refs.contact_pose[c] = dyn.placement(c);
         refs.contact_velocity[c] = v;
-        refs.contact_acceleration[c] = acceleration_[c];
+        refs.contact_acceleration[c] = feed_forward_[c];
       } else if (params_.follow_translation && in_contact[c]) {
         // Orientation held (previous reference, zero angular velocity); translation followed.
         const auto& X = dyn.placement(c);
         refs.contact_pose[c].translation() = X.translation();
         refs.contact_velocity[c] << v.template head<3>(), Eigen::Vector3d::Zero();
-        refs.contact_acceleration[c].template head<3>() = acceleration_[c].template head<3>();
+        refs.contact_acceleration[c].template head<3>() = feed_forward_[c].template head<3>();
         if (params_.hold_tipping_axis) {
           // Sole-frame axes: hold x (roll) only near a y edge, y (pitch) only near an x edge.
           const Eigen::Vector3d keep(insideBand(cop[c].y(), params_.sole_y_min, params_.sole_y_max) ? 1.0 : 0.0,
@@ -182,6 +202,12 @@ class TaskPlanner {
   const PlannerParameters& parameters() const { return params_; }
 
  private:
+  template <class V>
+  static void shrink(V&& a, double d) {
+    if (!(d > 0.0)) return;
+    for (int k = 0; k < 3; ++k) a[k] = std::copysign(std::max(std::abs(a[k]) - d, 0.0), a[k]);
+  }
+
   // The ZMP coordinate inside [lo + safe_margin, hi - safe_margin] (NaN: outside).
   bool insideBand(double z, double lo, double hi) const {
     return z >= lo + params_.safe_margin && z <= hi - params_.safe_margin;
@@ -215,7 +241,8 @@ class TaskPlanner {
   double com_alpha_ = 0.0;  // the same for the CoM reference's midpoint
   Eigen::Vector3d midpoint_ = Eigen::Vector3d::Zero();  // low-passed midpoint of the foot references
   std::array<bool, NC> have_velocity_{};
-  std::array<Vector6, NC> velocity_{}, acceleration_{};  // last measured v_F, filtered a_F
+  // last measured v_F, first filter stage, filtered a_F, a_F after the deadband (fed forward)
+  std::array<Vector6, NC> velocity_{}, stage_{}, acceleration_{}, feed_forward_{};
   double com_height_ = 0.0;
   bool initialized_ = false;
   std::array<bool, NC> safe_{};

@@ -186,6 +186,26 @@ TEST(ControllerConfig, NegativeOrInvalidValuesAreRejected) {
   expectRejected("  follow_acceleration_cutoff: 20", "  follow_acceleration_cutoff: -1",
                  "planner.follow_acceleration_cutoff");
   expectRejected("  follow_translation: true", "  follow_translation: maybe", "planner.follow_translation");
+  expectRejected("  follow_translation: true", "  follow_translation: true\n  follow_acceleration_order: 3",
+                 "planner.follow_acceleration_order");
+  expectRejected("  follow_translation: true",
+                 "  follow_translation: true\n  follow_acceleration_deadband: {linear: 0.5, angular: -1}",
+                 "planner.follow_acceleration_deadband.angular");
+}
+
+// The feed-forward filter's stages and deadband reach the planner; absent, one stage and none.
+TEST(ControllerConfig, FeedForwardOrderAndDeadband) {
+  const Config shipped = hqp::tasks::loadControllerConfig<Robot>(kYaml);
+  EXPECT_EQ(shipped.planner.follow_acceleration_order, 1);
+  EXPECT_EQ(shipped.planner.follow_acceleration_deadband_linear, 0.0);
+  EditedConfig f("  follow_translation: true",
+                 "  follow_translation: true\n  follow_acceleration_order: 2\n"
+                 "  follow_acceleration_deadband: {linear: 0.5, angular: 1.0}");
+  ASSERT_TRUE(f.found());
+  const Config c = hqp::tasks::loadControllerConfig<Robot>(f.path());
+  EXPECT_EQ(c.planner.follow_acceleration_order, 2);
+  EXPECT_EQ(c.planner.follow_acceleration_deadband_linear, 0.5);
+  EXPECT_EQ(c.planner.follow_acceleration_deadband_angular, 1.0);
 }
 
 // The moving-support options are optional; without them the planner is the paper's rule.

@@ -5,8 +5,10 @@
 // base at the origin of x and y) and that file's MuJoCo figures.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 
 #include "model/configuration.hpp"
 #include "tasks/contact_layout.hpp"
@@ -265,6 +267,62 @@ TEST_F(Planner, FeedForwardAccelerationOfAFollowingFoot) {
   step({Eigen::Vector2d(0.1, 0.0), Eigen::Vector2d::Zero()});
   EXPECT_TRUE(refs.contact_acceleration[0].isZero(0.0));
   EXPECT_GT(refs.contact_acceleration[1](0), 0.5 * a);
+}
+
+// Two cascaded stages and a deadband: a constant acceleration a through two identical first-order
+// stages (gain α) gives the closed form a (1 − βᵏ − α k βᵏ), β = 1 − α (the step response of the
+// cascade), and the deadband d takes max(· − d, 0) of it.
+TEST_F(Planner, FeedForwardThroughTwoStagesAndADeadband) {
+  const double fc = 20.0, dt = 0.001, a = 2.0, d = 0.5;
+  params.follow_acceleration_cutoff = fc;
+  params.follow_acceleration_order = 2;
+  params.follow_acceleration_deadband_linear = d;
+  params.follow_acceleration_deadband_angular = 0.1;
+  planner.configure(params, Robot::total_mass, dt);
+  const double alpha = 1.0 - std::exp(-2.0 * M_PI * fc * dt), beta = 1.0 - alpha;
+  VectorV v = VectorV::Zero();
+  for (int k = 0; k <= 300; ++k) {
+    v(0) = a * k * dt;
+    at(crouch(0.5 * a * k * dt * k * dt), v);
+    step(centre);
+    const double filtered = a * (1.0 - std::pow(beta, k) - alpha * k * std::pow(beta, k));
+    for (int c = 0; c < 2; ++c) {
+      EXPECT_NEAR(refs.contact_acceleration[c](0), std::max(filtered - d, 0.0), 1e-9) << "tick " << k;
+      EXPECT_NEAR(refs.contact_acceleration[c].tail<5>().norm(), 0.0, 1e-9);
+    }
+  }
+  EXPECT_NEAR(refs.contact_acceleration[0](0), a - d, 1e-6);  // settled
+}
+
+// White noise on the measured foot velocity: two stages pass far less of its finite difference
+// than one (the second stage rolls off the derivative's high frequencies), and a deadband above
+// what remains gives no feed-forward at all, so a foot on still ground is not shaken.
+TEST_F(Planner, FeedForwardRejectsVelocityNoise) {
+  auto noiseStd = [&](int order, double deadband) {
+    params.follow_acceleration_cutoff = 20.0;
+    params.follow_acceleration_order = order;
+    params.follow_acceleration_deadband_linear = deadband;
+    params.follow_acceleration_deadband_angular = deadband;
+    planner.configure(params, Robot::total_mass, 0.001);
+    std::mt19937 rng(7);
+    std::normal_distribution<double> n(0.0, 0.02);  // rad/s, the plant's encoder velocity noise
+    double sum2 = 0.0;
+    int count = 0;
+    for (int k = 0; k < 4000; ++k) {
+      VectorV v = VectorV::Zero();
+      for (int j = 6; j < Robot::nv; ++j) v(j) = n(rng);
+      at(crouch(), v);
+      step(centre);
+      if (k < 500) continue;  // the filters' start
+      sum2 += refs.contact_acceleration[0].squaredNorm();
+      ++count;
+    }
+    return std::sqrt(sum2 / count);
+  };
+  const double one = noiseStd(1, 0.0), two = noiseStd(2, 0.0);
+  EXPECT_GT(one, 1.0);  // m/s², rad/s²: the raw feed-forward is mostly noise
+  EXPECT_LT(two, 0.4 * one);
+  EXPECT_EQ(noiseStd(2, 10.0 * two), 0.0);
 }
 
 // hold_tipping_axis: outside the safe region only the rotation about the edge the ZMP is near
