@@ -10,9 +10,10 @@
 cmake_minimum_required(VERSION 3.25)
 file(REMOVE_RECURSE "${WORK_DIR}")
 set(prefix "${WORK_DIR}/prefix")
-# Only this prefix: no package registry, no other hqp elsewhere on the system.
+# Only this prefix: no package registry, no other hqp elsewhere on the system; the
+# compiler of the build under test.
 set(find_args "-DCMAKE_PREFIX_PATH=${prefix}" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF
-              -DCMAKE_FIND_USE_SYSTEM_PACKAGE_REGISTRY=OFF)
+              -DCMAKE_FIND_USE_SYSTEM_PACKAGE_REGISTRY=OFF "-DCMAKE_CXX_COMPILER=${CXX}")
 
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
