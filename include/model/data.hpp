@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cmath>
+#include <type_traits>
 
 #include <Eigen/Core>
 
@@ -14,6 +15,45 @@
 #include "model/spatial.hpp"
 
 namespace hqp::model {
+
+namespace detail {
+template <int R, int C>
+struct MatrixBuffer {
+  std::array<double, static_cast<std::size_t>(R) * C> values;
+};
+}  // namespace detail
+
+// An R x C matrix stored in place like Eigen::Matrix<double, R, C>, used through an
+// Eigen::Map. For sizes above EIGEN_STACK_ALLOCATION_LIMIT (128 KiB: nv > 128 for M), where
+// Eigen refuses to build a fixed-size matrix with OBJECT_ALLOCATED_ON_STACK_IS_TOO_BIG: the
+// storage stays inside its owner (no heap), and the limit itself, which also sizes Eigen's
+// stack temporaries, is left alone (docs/install.md, "Large robots").
+template <int R, int C>
+class MappedMatrix : private detail::MatrixBuffer<R, C>, public Eigen::Map<Eigen::Matrix<double, R, C>> {
+  using Buffer = detail::MatrixBuffer<R, C>;
+
+ public:
+  using Base = Eigen::Map<Eigen::Matrix<double, R, C>>;
+  MappedMatrix() noexcept : Buffer{}, Base(Buffer::values.data()) {}
+  // Copies the values and keeps pointing at its own storage.
+  MappedMatrix(const MappedMatrix& o) noexcept : Buffer(o), Base(Buffer::values.data()) {}
+  MappedMatrix& operator=(const MappedMatrix& o) noexcept {
+    Buffer::values = o.Buffer::values;
+    return *this;
+  }
+  template <class Derived>
+  MappedMatrix& operator=(const Eigen::DenseBase<Derived>& x) {
+    Base::operator=(x);
+    return *this;
+  }
+};
+
+// Eigen::Matrix<double, R, C> when Eigen accepts it as a fixed-size object, MappedMatrix
+// otherwise; both are fixed-size expressions with the same storage order.
+template <int R, int C>
+using FixedMatrix = std::conditional_t<(EIGEN_STACK_ALLOCATION_LIMIT == 0 ||
+                                        sizeof(double) * R * C <= EIGEN_STACK_ALLOCATION_LIMIT),
+                                       Eigen::Matrix<double, R, C>, MappedMatrix<R, C>>;
 
 template <class Robot>
 struct Data {
@@ -25,7 +65,7 @@ struct Data {
 
   using VectorQ = Eigen::Matrix<double, nq, 1>;
   using VectorV = Eigen::Matrix<double, nv, 1>;
-  using MatrixV = Eigen::Matrix<double, nv, nv>;
+  using MatrixV = FixedMatrix<nv, nv>;   // MappedMatrix for nv > 128
   using Jacobian = Eigen::Matrix<double, 6, nv>;
   using Matrix3V = Eigen::Matrix<double, 3, nv>;
 

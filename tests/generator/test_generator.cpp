@@ -24,6 +24,8 @@
 #include "gen_fused_pair_frames_model.hpp"
 #include "gen_fused_heavy_light_model.hpp"
 #include "gen_fused_pair_model.hpp"
+#include "gen_wild_frames_arm_model.hpp"
+#include "gen_wild_xacro_leg_model.hpp"
 #include "urdf_reference.hpp"
 #ifdef HQP_HAVE_WALKER3
 #include "walker3_model.hpp"
@@ -105,7 +107,11 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"bad_massless_moving.urdf", "link 'shank': joint 'knee' moves it, but it has no mass"},
         BadCase{"bad_negative_mass.urdf", "link 'thigh': negative or invalid mass"},
         BadCase{"bad_mass_not_a_number.urdf", "link 'thigh': <mass value='heavy'> is not a number"},
-        BadCase{"bad_not_positive_definite.urdf", "link 'thigh': the inertia is not positive definite"},
+        BadCase{"bad_not_positive_definite.urdf", "link 'thigh': the inertia is not positive semi-definite"},
+        // Zero inertias are fine on links, not on a body that moves.
+        BadCase{"bad_moving_zero_inertia.urdf",
+                "link 'shank': joint 'knee' moves it, but its inertia (with the links fixed to it) is not "
+                "positive definite"},
         BadCase{"bad_triangle_inequality.urdf", "link 'shank': the inertia violates the triangle inequality"},
         BadCase{"bad_missing_link.urdf", "joint 'knee': child link 'shank_typo' does not exist"},
         BadCase{"bad_zero_axis.urdf", "joint 'knee': zero axis"},
@@ -297,6 +303,12 @@ TEST(GeneratedVsUrdfdom, FusedPairSelectedFrames) {
   checkAgainstUrdfdom<fused_pair_frames::Robot>(kData + "/fused_pair.urdf", false);
 }
 TEST(GeneratedVsUrdfdom, FixedArm) { checkAgainstUrdfdom<fixed_arm::Robot>(kData + "/fixed_arm.urdf", true); }
+TEST(GeneratedVsUrdfdom, WildXacroLeg) {
+  checkAgainstUrdfdom<wild_xacro_leg::Robot>(kData + "/wild_xacro_leg.urdf", true);
+}
+TEST(GeneratedVsUrdfdom, WildFramesArm) {
+  checkAgainstUrdfdom<wild_frames_arm::Robot>(kData + "/wild_frames_arm.urdf", true);
+}
 #ifdef HQP_HAVE_WALKER3
 TEST(GeneratedVsUrdfdom, Walker3) { checkAgainstUrdfdom<walker3::Robot>(HQP_WALKER3_URDF, true); }
 #endif

@@ -122,11 +122,14 @@ inline void addLinkInertia(const RawLink& raw, const Transform& T, std::vector<L
     if (I.cwiseAbs().maxCoeff() != 0) throw linkError(raw.name, "mass is 0 but the inertia is not");
     return;
   }
-  // Principal moments, ascending.
+  // Principal moments, ascending. A link on its own may have a zero (or rounding-negative)
+  // moment: exporters write frame links of 1e-9 kg with a zero inertia, and urdfdom and
+  // MuJoCo accept them. What must be positive definite is the fused body that moves
+  // (setInertia); here only a clearly negative moment is an error.
   const Eigen::Vector3d e = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(I, Eigen::EigenvaluesOnly).eigenvalues();
   const double scale = std::max(I.cwiseAbs().maxCoeff(), std::numeric_limits<double>::min());
-  if (e(0) <= 1e-12 * scale) {
-    throw linkError(raw.name, "the inertia is not positive definite (smallest principal moment " +
+  if (e(0) < -1e-12 * scale) {
+    throw linkError(raw.name, "the inertia is not positive semi-definite (smallest principal moment " +
                                   show(e(0)) + ")");
   }
   // Triangle inequality on the principal moments; the tolerance admits flat
@@ -174,11 +177,15 @@ inline void setInertia(const RawRobot& r, const Group& g, Body& b) {
   if (!b.com.allFinite() || !b.inertia.allFinite()) {
     throw linkError(b.link, "the body's CoM or inertia overflows (links fixed to it lie too far apart)");
   }
-  // Safety net for the contract of docs/generated-model.md (rounding of the sums above).
+  // A moving body needs a positive definite inertia, or M is singular. Checked on the fused
+  // body, so zero-inertia frame links fixed to a body with inertia are fine. Relative to the
+  // largest moment: a positive moment 1e-12 times smaller is rounding of the sums above.
   const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(b.inertia, Eigen::EigenvaluesOnly).eigenvalues();
-  if (!(ev(0) >= -1e-12 * ev(2))) {
-    throw linkError(b.link, "the inertia of the links fused into this body is not positive semi-definite (principal moment " +
-                                show(ev(0)) + "): masses or distances too far apart");
+  if (!(ev(0) > 1e-12 * ev(2))) {
+    const std::string why = b.joint.empty() ? "it is the floating base"
+                                            : "joint " + quote(b.joint) + " moves it";
+    throw linkError(b.link, why + ", but its inertia (with the links fixed to it) is not positive definite "
+                                  "(smallest principal moment " + show(ev(0)) + ")");
   }
 }
 
