@@ -35,7 +35,7 @@ inline const char* toString(SafeModeReason r) {
   return "Unknown";
 }
 
-// Stages of one tick, in data-flow order (design guide, "One control tick").
+// Stages of one tick, in data-flow order (docs/architecture.md, "One control tick").
 enum class Stage : int { Estimator = 0, Dynamics, Planner, TaskUpdate, Solve, JointControl, Total, Count };
 
 // One priority level as solved this tick. For WqpWbc every level reports the single QP's
