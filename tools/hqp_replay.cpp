@@ -15,13 +15,14 @@
 
 #include "hqp/problem_file.hpp"
 #include "hqp/problem_instance.hpp"
+#include "tasks/balance_hierarchy.hpp"
+#include "walker3_model.hpp"
 
 namespace {
 
-// The shape this tool replays: the paper's Table I (Walker3, Nx = 30); another shape is
-// refused by the reader with both shapes in the message.
-using Replay = hqp::StackedHqp<30, hqp::LevelRows<6, 12>, hqp::LevelRows<12, 18>, hqp::LevelRows<3, 0>,
-                               hqp::LevelRows<15, 0>>;
+// The shape this replays: Walker3's hierarchy as its definition gives it (balance_hierarchy.hpp);
+// a recording of another shape is refused by the reader with both shapes in the message.
+using Replay = hqp::tasks::StackedHqpOf<hqp::tasks::BalanceHierarchy, hqp::tasks::ContactLayout<walker3::Robot, 2, 6>>;
 using Instance = hqp::ProblemInstance<Replay>;
 
 std::string activeSet(const hqp::HqpLevelResult<Replay::max_active>& l) {
@@ -104,7 +105,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "hqp_replay: no instance %ld (the file has %zu)\n", instance, instances.size());
     return 2;
   }
-  auto wbc = std::make_unique<Replay>(info.settings);  // ~0.3 MB: not on the stack
+  auto wbc = std::make_unique<Replay>(info.settings);  // ~0.36 MB (docs/hqp.md): not on the stack
   if (instance >= 0) {
     const Instance& in = instances[static_cast<std::size_t>(instance)];
     const Outcome o = replay(*wbc, in, cold);

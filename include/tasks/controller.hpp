@@ -4,6 +4,8 @@
 // constraint update (Table I) → HqpWbc or WqpWbc (Sec. IV-A) → τ_opt (eq. 6) → joint-level
 // control (eqs. 5, 7, 8). tick() allocates nothing, throws nothing, does no I/O, and never emits
 // a non-finite current: any failure switches to the safe mode of docs/controller.md.
+// The hierarchy is a template argument (a definition, tasks/hierarchy.hpp; Table I by default):
+// the solvers, the diagnostics' level count and task errors all follow from it.
 
 #include <Eigen/Core>
 
@@ -24,7 +26,7 @@
 
 namespace hqp::tasks {
 
-template <class Layout>
+template <class Layout, class Definition = BalanceHierarchy>
 class Controller {
  public:
   using Robot = typename Layout::robot;
@@ -35,8 +37,9 @@ class Controller {
   static constexpr int nx = Layout::nx;
   static_assert(cd == 6, "the Controller drives flat feet (6-D contact wrenches)");
   using Dynamics = typename Layout::Dynamics;
-  using Hqp = BalanceHqp<Layout>;
-  using Wqp = BalanceWqp<Layout>;
+  using Hierarchy = tasks::Hierarchy<Definition, Layout>;
+  using Hqp = typename Hierarchy::Hqp;
+  using Wqp = typename Hierarchy::Wqp;
   using Config = ControllerConfig<nj>;
   using Sensors = SensorData<nj, nc>;
   using Command = ActuatorCommand<nj>;
@@ -44,7 +47,7 @@ class Controller {
   using VectorX = Eigen::Matrix<double, nx, 1>;
   static constexpr int num_levels = Hqp::num_levels;
   static constexpr int max_active = Hqp::max_active;
-  using Diagnostics = ControllerDiagnostics<num_levels, nc, max_active>;
+  using Diagnostics = ControllerDiagnostics<num_levels, nc, max_active, Hierarchy::error_rows>;
 
   // Frames by index into Robot::frames: the soles (contact frames), the F/T sensors, and the
   // IMU (on the torso; the torso-posture task uses it). Configuration is applied here, once.
@@ -53,8 +56,10 @@ class Controller {
       : config_(config),
         dyn_(dynamicsFrames(sole_frames, imu_frame)),
         estimator_(sole_frames, ft_frames, imu_frame),
-        hqp_(hqpSettings(config)),
-        wqp_(QpSettings{}, config.wqp_priority_ratio) {
+        hqp_(config.qp.hqp),
+        wqp_(config.qp.wqp, config.wqp_priority_ratio) {
+    wqp_.setWarmStart(config.qp.wqp_warm_start);
+    wqp_.setDualMethod(config.qp.wqp_dual_method);
     estimator_.configure(config_.estimator);
     planner_.configure(config_.planner, Robot::total_mass, config_.dt);
     joint_.configure(config_.joint);
@@ -74,6 +79,7 @@ class Controller {
     resetHierarchyState(wqp_);
     started_ = false;
     diag_ = Diagnostics{};
+    diag_.task_error_offset = Hierarchy::error_offset;
     tau_hold_.setZero();
     dq_last_.setZero();
   }
@@ -120,13 +126,14 @@ class Controller {
     // 4.–5. Tasks and constraints (Table I), then the hierarchy (eqs. 3–4).
     VectorX x;
     QpStatus status;
+    const RobotState<Robot> state{estimator_.q(), estimator_.v()};
     if (config_.solver == Config::Solver::Hqp) {
-      updateHierarchy(hqp_, dyn_, refs_);
+      updateHierarchy(hqp_, dyn_, refs_, state);
       stage(Stage::TaskUpdate);
       status = hqp_.solve();
       x = hqp_.x();
     } else {
-      updateHierarchy(wqp_, dyn_, refs_);
+      updateHierarchy(wqp_, dyn_, refs_, state);
       stage(Stage::TaskUpdate);
       status = wqp_.solve();
       x = wqp_.x();
@@ -167,6 +174,14 @@ class Controller {
     return config_.solver == Config::Solver::Hqp ? hqp_.x() : wqp_.x();
   }
 
+  // f(item) on every task or constraint of type T in both solvers, for what configure(p) cannot
+  // carry (a task's own reference or gains). Set-up time; not in the tick.
+  template <class T, class F>
+  void configureItems(F f) {
+    forEachItemOfType<T>(hqp_, f);
+    forEachItemOfType<T>(wqp_, f);
+  }
+
  private:
   static std::array<int, nc + 1> dynamicsFrames(const std::array<int, nc>& soles, int imu) {
     std::array<int, nc + 1> f{};
@@ -174,8 +189,6 @@ class Controller {
     f[nc] = imu;
     return f;
   }
-  static HqpSettings hqpSettings(const Config&) { return HqpSettings{}; }
-
   // Torso tilt (angle between the torso z axis and world z) or torso height above the mean
   // sole height beyond the limits of SafeModeParameters.
   bool fallen() const {
@@ -261,12 +274,14 @@ class Controller {
     if (config_.solver == Config::Solver::Hqp) taskErrorsOf(hqp_);
     else taskErrorsOf(wqp_);
   }
+  // Every task's error by level, and the balance tasks' by name wherever their level is.
   template <class Wbc>
   void taskErrorsOf(const Wbc& wbc) {
-    const auto& foot = wbc.template level<1>().template task<0>().error();
-    for (int c = 0; c < nc; ++c) diag_.foot_error[c] = foot.template segment<6>(6 * c);
-    diag_.com_error = wbc.template level<2>().template task<0>().error();
-    diag_.torso_error = wbc.template level<3>().template task<0>().error();
+    stackTaskErrors(wbc, diag_.task_error);
+    if (const auto* t = findTask<ContactPoseTask<Layout>>(wbc))
+      for (int c = 0; c < nc; ++c) diag_.foot_error[c] = t->error().template segment<6>(6 * c);
+    if (const auto* t = findTask<LinearMomentumTask<Layout>>(wbc)) diag_.com_error = t->error();
+    if (const auto* t = findTask<TorsoPostureTask<Layout>>(wbc)) diag_.torso_error = t->error();
   }
 
   // Safe mode: τ = τ_hold − d q̇ (the last good torques, damped), k_f = 0, no ∫q̈ dt.

@@ -6,6 +6,8 @@
 
 #include <cstddef>
 
+#include "hqp/hqp_wbc.hpp"
+#include "hqp/qp_settings.hpp"
 #include "tasks/balance_parameters.hpp"
 #include "tasks/joint_controller.hpp"
 #include "tasks/state_estimator.hpp"
@@ -20,6 +22,14 @@ struct SafeModeParameters {
   double max_tilt = 0.8;         // rad, base tilt from upright beyond this counts as fallen
 };
 
+// The solvers' settings (YAML section `qp`); the defaults are HqpSettings' and QpSettings'.
+struct SolverSettings {
+  HqpSettings hqp{};             // HqpWbc: every level's QP (hqp.qp) and the hierarchy's options
+  QpSettings wqp{};              // WqpWbc's single QP
+  bool wqp_warm_start = true;    // WqpWbc::setWarmStart
+  bool wqp_dual_method = true;   // WqpWbc::setDualMethod
+};
+
 template <int NJ>
 struct ControllerConfig {
   enum class Solver { Hqp, Wqp };
@@ -31,6 +41,7 @@ struct ControllerConfig {
   EstimatorParameters estimator;
   JointControlParameters<NJ> joint;
   SafeModeParameters safe;
+  SolverSettings qp;
 };
 
 // A configuration from the URDF alone (no YAML): torque limits = effort, friction

@@ -92,6 +92,24 @@ class ConfigReader {
     return x;
   }
 
+  // A whole number at path.key with lo ≤ n ≤ hi.
+  int integer(const YAML::Node& parent, const std::string& path, const std::string& key, int lo, int hi) const {
+    const std::string full = join(path, key);
+    const double x = number(child(parent, path, key), full);
+    if (!(x >= lo && x <= hi) || x != std::floor(x)) {
+      fail("'" + full + "' = " + child(parent, path, key).Scalar() + " must be a whole number in [" +
+           std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    }
+    return static_cast<int>(x);
+  }
+
+  // A tolerance at path.key: finite, 0 < x < 1.
+  double tolerance(const YAML::Node& parent, const std::string& path, const std::string& key) const {
+    const double x = atLeast(parent, path, key, 0.0, true);
+    if (!(x < 1.0)) fail("'" + join(path, key) + "' = " + std::to_string(x) + " must be < 1");
+    return x;
+  }
+
   bool boolean(const YAML::Node& parent, const std::string& path, const std::string& key) const {
     const std::string full = join(path, key);
     const YAML::Node n = child(parent, path, key);
@@ -172,7 +190,7 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
     r.fail(std::string("YAML error: ") + e.what());
   }
   if (!root.IsMap()) r.fail("the top level must be a map");
-  r.onlyKeys(root, "", {"controller", "balance", "planner", "estimator", "joint_control", "safe_mode"});
+  r.onlyKeys(root, "", {"controller", "balance", "planner", "estimator", "joint_control", "safe_mode", "qp"});
 
   ControllerConfig<nj> c;
   {
@@ -346,6 +364,42 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
     c.safe.damping = r.atLeast(n, p, "damping", 0.0, false);
     c.safe.min_base_height = r.finite(n, p, "min_base_height");
     c.safe.max_tilt = r.atLeast(n, p, "max_tilt", 0.0, true);
+  }
+  if (root["qp"]) {  // optional section and keys: absent = the solvers' defaults
+    const YAML::Node n = r.map(root, "", "qp", {"hqp", "wqp"});
+    // The QpSettings keys of one solver, each optional.
+    const auto qpKeys = [&](const YAML::Node& m, const std::string& p, QpSettings& q) {
+      if (m["max_iterations"]) q.max_iterations = r.integer(m, p, "max_iterations", 1, 1000000);
+      if (m["feasibility_tol"]) q.feasibility_tol = r.tolerance(m, p, "feasibility_tol");
+      if (m["rank_tol"]) q.rank_tol = r.tolerance(m, p, "rank_tol");
+      if (m["dual_tol"]) q.dual_tol = r.tolerance(m, p, "dual_tol");
+      if (m["max_magnitude"]) {
+        q.max_magnitude = r.atLeast(m, p, "max_magnitude", 0.0, true);
+        // The solvers square and multiply such numbers: keep that far from overflow.
+        if (q.max_magnitude > 1e100) r.fail("'" + p + ".max_magnitude' must be <= 1e100");
+      }
+    };
+    if (n["hqp"]) {
+      const std::string p = "qp.hqp";
+      const YAML::Node m = r.map(n, "qp", "hqp",
+                                 {"max_iterations", "feasibility_tol", "rank_tol", "dual_tol", "max_magnitude",
+                                  "level_rank_tol", "warm_start", "dual_last_level", "residual_rise_tol"});
+      HqpSettings& h = c.qp.hqp;
+      qpKeys(m, p, h.qp);
+      if (m["level_rank_tol"]) h.rank_tol = r.tolerance(m, p, "level_rank_tol");
+      if (m["warm_start"]) h.warm_start = r.boolean(m, p, "warm_start");
+      if (m["dual_last_level"]) h.dual_last_level = r.boolean(m, p, "dual_last_level");
+      if (m["residual_rise_tol"]) h.residual_rise_tol = r.tolerance(m, p, "residual_rise_tol");
+    }
+    if (n["wqp"]) {
+      const std::string p = "qp.wqp";
+      const YAML::Node m = r.map(n, "qp", "wqp",
+                                 {"max_iterations", "feasibility_tol", "rank_tol", "dual_tol", "max_magnitude",
+                                  "warm_start", "dual_method"});
+      qpKeys(m, p, c.qp.wqp);
+      if (m["warm_start"]) c.qp.wqp_warm_start = r.boolean(m, p, "warm_start");
+      if (m["dual_method"]) c.qp.wqp_dual_method = r.boolean(m, p, "dual_method");
+    }
   }
   return c;
 }

@@ -35,7 +35,7 @@ inline const char* toString(SafeModeReason r) {
   return "Unknown";
 }
 
-// Stages of one tick, in data-flow order (design guide, "One control tick").
+// Stages of one tick, in data-flow order (docs/architecture.md, "One control tick").
 enum class Stage : int { Estimator = 0, Dynamics, Planner, TaskUpdate, Solve, JointControl, Total, Count };
 
 // One priority level as solved this tick. For WqpWbc every level reports the single QP's
@@ -51,9 +51,12 @@ struct LevelDiagnostics {
   double time_us = 0.0;   // this level's solve time (HqpWbc only; 0 for WqpWbc, one QP)
 };
 
-template <int NumLevels, int NumContacts, int MaxActive>
+// TaskErrorRows: all levels' task errors stacked (Hierarchy::error_rows).
+template <int NumLevels, int NumContacts, int MaxActive, int TaskErrorRows = 0>
 struct ControllerDiagnostics {
+  using TaskErrors = Eigen::Matrix<double, (TaskErrorRows > 0 ? TaskErrorRows : 1), 1>;
   ControllerDiagnostics() {
+    task_error.setZero();
     for (auto& z : zmp_measured) z.setZero();
     for (auto& z : zmp_optimized) z.setZero();
     for (auto& e : foot_error) e.setZero();
@@ -72,7 +75,14 @@ struct ControllerDiagnostics {
   std::array<bool, NumContacts> following{};        // planner: ZMP in the safe region (Sec. III-A)
   std::array<Eigen::Vector2d, NumContacts> zmp_measured{};   // sole frame (m)
   std::array<Eigen::Vector2d, NumContacts> zmp_optimized{};  // from F*, sole frame (m)
-  // Task errors (reference − current), as the tasks used them this tick.
+  // Task errors (reference − current), as the tasks used them this tick: every task's error() in
+  // priority order, level p in rows [task_error_offset[p], task_error_offset[p + 1]).
+  TaskErrors task_error;
+  std::array<int, NumLevels + 1> task_error_offset{};
+  auto levelTaskError(int p) const {
+    return task_error.segment(task_error_offset[p], task_error_offset[p + 1] - task_error_offset[p]);
+  }
+  // The same errors of the balance tasks by name (zero if the hierarchy lacks the task).
   std::array<Eigen::Matrix<double, 6, 1>, NumContacts> foot_error{};  // [position; rotation vector]
   Eigen::Vector3d com_error = Eigen::Vector3d::Zero();
   Eigen::Vector3d torso_error = Eigen::Vector3d::Zero();     // rotation vector, world

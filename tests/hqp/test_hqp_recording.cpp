@@ -16,6 +16,8 @@
 
 #include "hqp/problem_file.hpp"
 #include "hqp/problem_instance.hpp"
+#include "tasks/balance_hierarchy.hpp"
+#include "walker3_model.hpp"
 #include "support/allocation_counter.hpp"
 
 #ifndef HQP_RECORDING_FILE
@@ -25,11 +27,17 @@
 namespace {
 
 using hqp::LevelRows;
-// Walker3's Table I (as recorded): 6 | 12, 12 | 18, 3, 15 rows over 30 variables.
-using Replay = hqp::StackedHqp<30, LevelRows<6, 12>, LevelRows<12, 18>, LevelRows<3, 0>, LevelRows<15, 0>>;
+// Walker3's hierarchy as its definition gives it (as recorded: 6 | 12, 12 | 18, 3, 15 rows over 30).
+using Replay = hqp::tasks::StackedHqpOf<hqp::tasks::BalanceHierarchy, hqp::tasks::ContactLayout<walker3::Robot, 2, 6>>;
 using Instance = hqp::ProblemInstance<Replay>;
-// Another shape, for the dimension check (never solved: no HqpWbc code is generated for it).
-using Other = hqp::StackedHqp<30, LevelRows<6, 12>, LevelRows<12, 16>, LevelRows<3, 0>, LevelRows<15, 0>>;
+template <int P>
+using Rows = LevelRows<Replay::LevelType<P>::task_rows, Replay::LevelType<P>::constraint_rows>;
+static_assert(Replay::num_levels == 4, "Table I");
+// Another shape, for the dimension check: level 2 with two constraint rows fewer (never solved:
+// no HqpWbc code is generated for it).
+using Other = hqp::StackedHqp<Replay::nx, Rows<0>,
+                              LevelRows<Replay::LevelType<1>::task_rows, Replay::LevelType<1>::constraint_rows - 2>,
+                              Rows<2>, Rows<3>>;
 
 const std::vector<Instance>& recorded(hqp::ProblemFileInfo* info = nullptr) {
   static hqp::ProblemFileInfo i;

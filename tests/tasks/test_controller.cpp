@@ -6,10 +6,16 @@
 
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <limits>
 #include <memory>
 #include <new>
+#include <sstream>
+#include <string>
+
+#include <unistd.h>
 
 #include "model/rnea.hpp"
 #include "support/walker3_controller.hpp"
@@ -179,6 +185,63 @@ TEST(ControllerSafeMode, FallDetectedFromTorsoTilt) {
   EXPECT_EQ(ctrl->diagnostics().mode, ControllerMode::Safe);
   EXPECT_EQ(ctrl->diagnostics().reason, SafeModeReason::Fallen);
   EXPECT_TRUE(cmd.current.allFinite());
+}
+
+// The shipped controller.yaml with `from` replaced by `to`, loaded; solver and C as walker3Config.
+Controller::Config editedConfig(const std::string& from, const std::string& to, Controller::Config::Solver solver,
+                                double com_height) {
+  std::ifstream in(HQP_SOURCE_DIR "/robots/walker3/controller.yaml");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string text = ss.str();
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  const std::string path = ::testing::TempDir() + "qp_" + std::to_string(::getpid()) + ".yaml";
+  std::ofstream(path) << text;
+  auto cfg = hqp::tasks::loadControllerConfig<Robot>(path);
+  std::remove(path.c_str());
+  cfg.solver = solver;
+  cfg.planner.com_height = com_height;
+  return cfg;
+}
+
+// The `qp` keys reach the solvers: a magnitude bound below the robot's mass (M's base block holds
+// the total mass, 43 kg) makes each solver refuse the problem as invalid input (safe mode), and
+// dual_last_level decides how HqpWbc solves its last level.
+TEST(ControllerQpSettings, YamlValuesReachTheSolvers) {
+  const auto s = hqp::testing::walker3Standing();
+  const double half = 0.5 * Robot::total_mass * kG;
+  const auto sensors = hqp::testing::walker3RestingSensors(
+      s, {half, half}, {Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()});
+  using Solver = Controller::Config::Solver;
+  ASSERT_GT(Robot::total_mass, 1.0);
+  Controller::Command cmd;
+  {
+    auto ctrl = makeWalker3Controller(
+        editedConfig("max_magnitude: 1.0e50", "max_magnitude: 1.0", Solver::Hqp, s.com_height));
+    EXPECT_EQ(ctrl->hqp().settings().qp.max_magnitude, 1.0);
+    ctrl->tick(sensors, cmd);
+    EXPECT_EQ(ctrl->diagnostics().levels[0].status, hqp::QpStatus::InvalidInput);
+    EXPECT_EQ(ctrl->diagnostics().reason, SafeModeReason::SolverFailure);
+  }
+  {
+    auto ctrl = makeWalker3Controller(
+        editedConfig("    max_magnitude: 1.0e50\n    warm_start: true", "    max_magnitude: 1.0\n    warm_start: true",
+                     Solver::Wqp, s.com_height));
+    ctrl->tick(sensors, cmd);
+    EXPECT_EQ(ctrl->diagnostics().status, hqp::QpStatus::InvalidInput);
+    EXPECT_EQ(ctrl->diagnostics().reason, SafeModeReason::SolverFailure);
+  }
+  for (bool dual : {true, false}) {
+    auto ctrl = makeWalker3Controller(editedConfig("dual_last_level: true", dual ? "dual_last_level: true"
+                                                                                 : "dual_last_level: false",
+                                                   Solver::Hqp, s.com_height));
+    EXPECT_EQ(ctrl->hqp().settings().qp.max_iterations, 100);
+    ctrl->tick(sensors, cmd);
+    ASSERT_EQ(ctrl->diagnostics().mode, ControllerMode::Balance);
+    EXPECT_EQ(ctrl->hqp().result().levels[Controller::num_levels - 1].dual, dual);
+  }
 }
 
 TEST(ControllerNoAlloc, TickDoesNotAllocate) {

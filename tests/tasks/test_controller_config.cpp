@@ -238,6 +238,54 @@ TEST(ControllerConfig, OtherSolverAndInfiniteLeakLoad) {
             std::numeric_limits<double>::infinity());
 }
 
+// The shipped `qp` section holds the solvers' defaults (behaviour as without it), and a file
+// without the section loads with those defaults.
+TEST(ControllerConfig, QpSectionDefaultsAreTheSolversDefaults) {
+  const hqp::HqpSettings h;
+  const hqp::QpSettings q;
+  {
+    // Without the section (it is the file's last).
+    std::string text = readText(kYaml);
+    text = text.substr(0, text.find("\nqp:\n"));
+    const std::string path = ::testing::TempDir() + "no_qp_" + std::to_string(::getpid()) + ".yaml";
+    std::ofstream(path) << text;
+    const Config c = hqp::tasks::loadControllerConfig<Robot>(path);
+    std::remove(path.c_str());
+    EXPECT_EQ(c.qp.hqp.qp.max_iterations, h.qp.max_iterations);
+    EXPECT_EQ(c.qp.hqp.rank_tol, h.rank_tol);
+    EXPECT_TRUE(c.qp.wqp_dual_method);
+  }
+  const Config c = hqp::tasks::loadControllerConfig<Robot>(kYaml);
+  for (const hqp::QpSettings* s : {&c.qp.hqp.qp, &c.qp.wqp}) {
+    EXPECT_EQ(s->max_iterations, q.max_iterations);
+    EXPECT_EQ(s->feasibility_tol, q.feasibility_tol);
+    EXPECT_EQ(s->rank_tol, q.rank_tol);
+    EXPECT_EQ(s->dual_tol, q.dual_tol);
+    EXPECT_EQ(s->max_magnitude, q.max_magnitude);
+  }
+  EXPECT_EQ(c.qp.hqp.rank_tol, h.rank_tol);
+  EXPECT_EQ(c.qp.hqp.warm_start, h.warm_start);
+  EXPECT_EQ(c.qp.hqp.dual_last_level, h.dual_last_level);
+  EXPECT_EQ(c.qp.hqp.residual_rise_tol, h.residual_rise_tol);
+  EXPECT_TRUE(c.qp.wqp_warm_start);
+  EXPECT_TRUE(c.qp.wqp_dual_method);
+  EditedConfig seven("max_iterations: 100", "max_iterations: 7");
+  ASSERT_TRUE(seven.found());
+  EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(seven.path()).qp.hqp.qp.max_iterations, 7);
+}
+
+TEST(ControllerConfig, BadQpValuesNameTheKey) {
+  expectRejected("max_iterations: 100", "max_iterations: 0", "qp.hqp.max_iterations");
+  expectRejected("max_iterations: 100", "max_iterations: 2.5", "qp.hqp.max_iterations");
+  expectRejected("feasibility_tol: 1.0e-9", "feasibility_tol: -1.0e-9", "qp.hqp.feasibility_tol");
+  expectRejected("level_rank_tol: 1.0e-9", "level_rank_tol: 2", "qp.hqp.level_rank_tol");
+  expectRejected("residual_rise_tol: 1.0e-6", "residual_rise_tol: .nan", "qp.hqp.residual_rise_tol");
+  expectRejected("max_magnitude: 1.0e50", "max_magnitude: 1.0e200", "qp.hqp.max_magnitude");
+  expectRejected("    dual_method: true", "    dual_method: sometimes", "qp.wqp.dual_method");
+  expectRejected("    dual_method: true", "    dual_methods: true", "qp.wqp.dual_methods");
+  expectRejected("    warm_start: true          #", "    warmstart: true          #", "qp.hqp.warmstart");
+}
+
 TEST(ControllerConfig, MissingOrBrokenFileNamesTheFile) {
   const std::string missing = ::testing::TempDir() + "no_such_controller.yaml";
   const std::string msg = loadError(missing);
