@@ -5,8 +5,9 @@
 #   3. find_package(hqp COMPONENTS ...): known ones give their targets, the core target links
 #      Eigen only, an unknown one fails the configure;
 #   4. user_project/: Walker3 model from the installed URDF (hqp_add_robot_model), controller
-#      from the installed YAML, ticks on synthetic standing data.
-# Variables: BUILD_DIR, WORK_DIR, TEST_DIR, VERSION, PKG_CONFIG, CXX, HAVE_IDENT.
+#      from the installed YAML, ticks on synthetic standing data;
+#   5. generator_project/: hqp_add_robot_model with FRAMES on a small URDF of the user's.
+# Variables: BUILD_DIR, WORK_DIR, TEST_DIR, VERSION, PKG_CONFIG, CXX, HAVE_IDENT, FUSED_PAIR_URDF.
 cmake_minimum_required(VERSION 3.25)
 file(REMOVE_RECURSE "${WORK_DIR}")
 set(prefix "${WORK_DIR}/prefix")
@@ -85,3 +86,13 @@ message(STATUS "4. user project:\n${out}")
 if(NOT out MATCHES "ok: 10 ticks")
   message(FATAL_ERROR "the user project did not report success")
 endif()
+
+# 5. The generator on the user's own URDF, with an extra frame.
+run(${CMAKE_COMMAND} -S "${TEST_DIR}/generator_project" -B "${WORK_DIR}/generator_build" ${find_args}
+    "-DROBOT_URDF=${FUSED_PAIR_URDF}")
+run(${CMAKE_COMMAND} --build "${WORK_DIR}/generator_build")
+run("${WORK_DIR}/generator_build/app")
+if(NOT out STREQUAL "nv=7 nframes=3\n")
+  message(FATAL_ERROR "generator project printed '${out}'")
+endif()
+message(STATUS "5. generator project: ok")

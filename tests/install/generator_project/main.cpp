@@ -1,4 +1,4 @@
-// Built against an installed hqp_wbc by tests/generator/install_smoke.cmake.
+// Built against an installed hqp_wbc by tests/install/install_test.cmake (step 5).
 #include <cstdio>
 
 #include "my_robot_model.hpp"
