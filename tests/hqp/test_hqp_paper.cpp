@@ -200,6 +200,7 @@ TEST(HqpPaperShape, LowerLevelsNeverChangeHigherResiduals) {
                   1e-9 * (1.0 + before.levels[static_cast<size_t>(p)].residual));
     moved += (wbc.x() - before.x).norm() > 1e-6;
   }
+  EXPECT_GT(moved, 0) << "the lower levels never moved x: the residual checks above prove nothing";
 }
 
 TEST(HqpPaperShape, SolveNeverAllocates) {
