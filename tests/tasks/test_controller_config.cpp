@@ -101,8 +101,8 @@ TEST(ControllerConfig, ShippedFileLoads) {
   EXPECT_EQ(c.balance.com_ki, 4.0);
   EXPECT_EQ(c.balance.com_integral_limit, 0.03);
   EXPECT_TRUE(c.planner.hold_tipping_axis);
-  EXPECT_EQ(c.balance.com_vertical.kp, 1.0);
-  EXPECT_EQ(c.balance.com_vertical.kd, 2.0);
+  EXPECT_EQ(c.balance.com_vertical.kp, 9.0);
+  EXPECT_EQ(c.balance.com_vertical.kd, 6.0);
   EXPECT_EQ(c.balance.torsion_radius, 0.05);
   EXPECT_EQ(c.estimator.contact_threshold, 8.0);
   EXPECT_LT(c.estimator.contact_threshold, c.balance.fz_min);
@@ -147,7 +147,7 @@ TEST(ControllerConfig, MissingKeyNamesKeyAndFile) {
   expectRejected("  max_tilt: 0.8", "  # gone", "safe_mode.max_tilt");
   expectRejected("com:          {kp: 4, kd: 3}", "com:          {kp: 4}", "balance.com.kd");
   expectRejected("com_integral: {ki: 4, limit: 0.03}", "com_integral: {ki: 4}", "balance.com_integral.limit");
-  expectRejected("  com_vertical: {kp: 1, kd: 2}", "  # com_vertical gone", "balance.com_vertical");
+  expectRejected("  com_vertical: {kp: 9, kd: 6}", "  # com_vertical gone", "balance.com_vertical");
   expectRejected("  torsion_radius: 0.05", "  # torsion_radius gone", "balance.torsion_radius");
   expectRejected("    r_knee:         250", "    # r_knee", "balance.torque_limit.r_knee");
   expectRejected("torque_constant: 5, current_limit: 16", "current_limit: 16",  // the left one
@@ -170,7 +170,7 @@ TEST(ControllerConfig, NegativeOrInvalidValuesAreRejected) {
   expectRejected("dcm_low: 0.07, dcm_high: 0.10", "dcm_low: 0.10, dcm_high: 0.07", "balance.com_schedule.dcm_high");
   expectRejected("com_integral: {ki: 4,", "com_integral: {ki: -4,", "balance.com_integral.ki");
   expectRejected("  hold_tipping_axis: true", "  hold_tipping_axis: 2x", "planner.hold_tipping_axis");
-  expectRejected("com_vertical: {kp: 1, kd: 2}", "com_vertical: {kp: 1, kd: -2}", "balance.com_vertical.kd");
+  expectRejected("com_vertical: {kp: 9, kd: 6}", "com_vertical: {kp: 9, kd: -6}", "balance.com_vertical.kd");
   expectRejected("  torsion_radius: 0.05", "  torsion_radius: 0", "balance.torsion_radius");
   // A foot loaded with fz_min must count as in contact.
   expectRejected("  contact_threshold: 8", "  contact_threshold: 10", "estimator.contact_threshold");
