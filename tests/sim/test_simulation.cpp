@@ -430,7 +430,7 @@ TEST(SimController, RecoversFromA10NsPushAlongX) {
   if (!hqp::sim::balanceControllerAvailable()) GTEST_SKIP() << "built without the balance controller";
   const hqp::sim::RunSummary r = runPreset("push_x", {"pushes=1.5:10:0", "duration=4.5"});
   expectPassed(r, 4.5);
-  EXPECT_GT(r.max_abs_pitch, 0.02) << "the push did not reach the robot";
+  EXPECT_GT(r.max_abs_pitch, 0.01) << "the push did not reach the robot (quiet standing: < 0.001 rad)";
   EXPECT_GT(r.com_x_max, 0.005);
 }
 
