@@ -42,16 +42,24 @@ double violation(const Eigen::MatrixXd& C, const Eigen::VectorXd& lo, const Eige
 
 // A problem with a feasible point (checked by the caller): ActiveSetQp must not call it
 // Infeasible, and an Optimal answer meets every row (rounding of large row values aside).
-template <int N, int M, int E, int I>
-void expectNotInfeasible(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const Eigen::MatrixXd& C,
-                         const Eigen::VectorXd& lo, const Eigen::VectorXd& up) {
-  hqp::ActiveSetQp<N, M, E, I> qp;
-  qp.resize(N, M, E, I);
+// min ½‖A x − b‖² s.t. lo ≤ C x ≤ up (no equality rows) loaded into an ActiveSetQp of full size.
+template <int N, int M, int I>
+void load(hqp::ActiveSetQp<N, M, 0, I>& qp, const Eigen::MatrixXd& A, const Eigen::VectorXd& b,
+          const Eigen::MatrixXd& C, const Eigen::VectorXd& lo, const Eigen::VectorXd& up) {
+  qp.resize(N, M, 0, I);
   qp.A() = A;
   qp.b() = b;
   qp.C() = C;
   qp.lower() = lo;
   qp.upper() = up;
+}
+
+template <int N, int M, int E, int I>
+void expectNotInfeasible(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const Eigen::MatrixXd& C,
+                         const Eigen::VectorXd& lo, const Eigen::VectorXd& up) {
+  static_assert(E == 0, "the problems have no equality rows");
+  hqp::ActiveSetQp<N, M, E, I> qp;
+  load(qp, A, b, C, lo, up);
   const hqp::QpStatus s = qp.solve(false);
   EXPECT_NE(s, hqp::QpStatus::Infeasible);
   if (s == hqp::QpStatus::Optimal) {
@@ -510,12 +518,7 @@ TEST(QpContracts, ActiveSetMatchesEnumerationWithTheOptimumFarOut) {
   lo << 143.08216171267756, 187.80091171267756, 164.80091171267756, 187.80091171267756, 187.80091171267756;
   up << kInf, 219.80091171267756, 196.80091171267756, 219.80091171267756, 219.80091171267756;
   hqp::ActiveSetQp<4, 3, 0, 5> qp;
-  qp.resize(4, 3, 0, 5);
-  qp.A() = A;
-  qp.b() = b;
-  qp.C() = C;
-  qp.lower() = lo;
-  qp.upper() = up;
+  load(qp, A, b, C, lo, up);
   ASSERT_EQ(str(qp.solve(false)), "Optimal");
   EXPECT_LE(violation(C, lo, up, qp.x(), 1e-9), 1e-9);
   const auto ref = hqp::testing::bruteForceQp(A, b, Eigen::MatrixXd(0, 4), Eigen::VectorXd(0), C, lo, up, 1e-9);
@@ -539,12 +542,7 @@ TEST(QpContracts, DualAndPrimalAgreeUpToTheToleranceOnNearlyParallelRows) {
   ASSERT_TRUE(dual.factorize(A, b, 3, 2, 1e-9));
   const hqp::QpStatus sd = dual.solve(C, lo, up, 7, hqp::QpSettings{});
   hqp::ActiveSetQp<2, 3, 0, 7> primal;
-  primal.resize(2, 3, 0, 7);
-  primal.A() = A;
-  primal.b() = b;
-  primal.C() = C;
-  primal.lower() = lo;
-  primal.upper() = up;
+  load(primal, A, b, C, lo, up);
   ASSERT_EQ(str(primal.solve(false)), "Optimal");
   ASSERT_EQ(str(sd), "Optimal");
   const Eigen::VectorXd xd = dual.x(), xp = primal.x();
