@@ -46,6 +46,14 @@ struct HqpSettings {
   // a larger rise (lower levels' data so large that their rounding swamps a higher level) is
   // reported as HqpLevelResult::degraded and HqpResult::higher_level_degraded.
   double residual_rise_tol = 1e-6;
+  // Deadline (docs/hqp.md, "Deadline-aware solving"): level p ≥ 1 is cut, i.e. it and every
+  // lower level are skipped and x keeps x*_{p−1} (their part of x is the minimum-norm
+  // completion, 0 in the null space of the levels solved), if starting it would exceed a budget:
+  //   elapsed µs since solve() began + the level's µs in the last solve that ran it > budget_us,
+  //   QP iterations so far + the level's iterations in that solve > budget_iterations.
+  // Level 0 is always solved. 0 (or any value not > 0) = no budget; off by default.
+  double budget_us = 0.0;
+  int budget_iterations = 0;
 };
 
 // What happened at one level; MaxActive = capacity of the stacked constraint rows.
@@ -70,6 +78,8 @@ struct HqpLevelResult {
   // value at x*_p: the lower levels degraded it (numerical health, docs/hqp.md).
   bool degraded = false;
 };
+// A level cut by the budget has status BudgetCut, iterations 0, and residual / objective at the
+// final x.
 
 template <int Nx, int NumLevels, int MaxActive>
 struct HqpResult {
@@ -79,6 +89,9 @@ struct HqpResult {
   // Some level's residual was degraded by the lower levels (HqpLevelResult::degraded): x is
   // finite but does not keep the priorities to tolerance. Treat as a solver failure.
   bool higher_level_degraded = false;
+  // First level cut by the budget (HqpSettings::budget_us / budget_iterations), −1 if none.
+  // If no higher level failed, status is then QpStatus::BudgetCut and failed_level == cut_level.
+  int cut_level = -1;
   std::array<HqpLevelResult<MaxActive>, NumLevels> levels{};
 };
 
@@ -185,15 +198,26 @@ class HqpWbc {
   void setRankTolerance(double tol) { settings_.rank_tol = tol; }
   void setWarmStart(bool on) { settings_.warm_start = on; }
   void setDualLastLevel(bool on) { settings_.dual_last_level = on; }
+  // Per-solve budget (HqpSettings::budget_us / budget_iterations; ≤ 0 = none).
+  void setBudget(double us, int iterations) {
+    settings_.budget_us = us;
+    settings_.budget_iterations = iterations;
+  }
 
-  // Forget every level's working set (the next solve starts cold).
+  // Forget every level's working set (the next solve starts cold) and the budget's cost
+  // estimates (HqpSettings::budget_us).
   void resetWarmStart() {
     std::apply([](auto&... qp) { (resetQp(qp), ...); }, qps_);
     resetQp(slack_qp_);
+    last_time_us_.fill(0.0);
+    last_iterations_.fill(0);
   }
 
   // Solves the hierarchy; no heap, no exceptions, bounded by the QPs' iteration caps.
   QpStatus solve() noexcept {
+    solve_start_ = std::chrono::steady_clock::now();
+    iterations_used_ = 0;
+    result_.cut_level = -1;
     stackAll(std::make_index_sequence<sizeof...(Levels)>{});
     result_.status = QpStatus::Optimal;
     result_.failed_level = -1;
@@ -340,13 +364,19 @@ class HqpWbc {
       auto& lr = result_.levels[ps];
       if (var_[ps] > 0) xs += up_[ps].norm();
       const int t0 = task_offset[ps], r = task_offset[ps + 1] - t0;
-      double an2 = 0.0, bn2 = 0.0, e2 = 0.0;
+      double an2 = 0.0, bn2 = 0.0, e2 = 0.0, e2u = 0.0;
       for (int i = t0; i < t0 + r; ++i) {
         const double w = w_(i);
         const double e = A_.row(i).dot(x_) - b_(i);
         an2 += w * A_.row(i).squaredNorm();
         bn2 += w * b_(i) * b_(i);
         e2 += w * e * e;
+        e2u += e * e;
+      }
+      if (lr.status == QpStatus::BudgetCut) {  // not solved: report where x left it
+        lr.objective = e2;
+        lr.residual = e2u;
+        continue;
       }
       const double tol = settings_.residual_rise_tol *
                          (std::sqrt(an2) * std::max(xs, 1.0) + std::sqrt(bn2));
@@ -366,9 +396,41 @@ class HqpWbc {
   template <int P>
   void timedLevel() {
     const auto start = std::chrono::steady_clock::now();
+    if (result_.cut_level < 0 && P > 0 && overBudget(P, start)) result_.cut_level = P;
+    if (result_.cut_level >= 0) return skipLevel(P);
     solveLevel<P>();
-    result_.levels[P].time_us =
-        std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+    auto& lr = result_.levels[P];
+    lr.time_us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+    iterations_used_ += lr.iterations;
+    last_time_us_[P] = lr.time_us;  // the next solve's estimate of this level
+    last_iterations_[P] = lr.iterations;
+  }
+
+  // Would starting level p exceed the budget (HqpSettings::budget_us / budget_iterations)?
+  // The level's cost is estimated by its cost in the last solve that ran it (warm-started
+  // levels cost about the same from tick to tick).
+  template <class TimePoint>
+  bool overBudget(int p, TimePoint now) const {
+    const std::size_t ps = static_cast<std::size_t>(p);
+    if (settings_.budget_iterations > 0 &&
+        iterations_used_ + last_iterations_[ps] > settings_.budget_iterations)
+      return true;
+    if (!(settings_.budget_us > 0.0)) return false;
+    const double elapsed = std::chrono::duration<double, std::micro>(now - solve_start_).count();
+    return elapsed + last_time_us_[ps] > settings_.budget_us;
+  }
+
+  // A level cut by the budget: no contribution to x (reconstructX skips var_ = 0).
+  void skipLevel(int p) {
+    const std::size_t ps = static_cast<std::size_t>(p);
+    auto& lr = result_.levels[ps];
+    lr = HqpLevelResult<max_active>{};
+    lr.status = QpStatus::BudgetCut;
+    lr.variables = n_;
+    lr.null_dim = n_;
+    var_[ps] = 0;
+    rank_[ps] = 0;
+    noteStatus(p, QpStatus::BudgetCut);
   }
 
   void noteStatus(int p, QpStatus s) {
@@ -862,6 +924,11 @@ class HqpWbc {
   Eigen::Matrix<double, Nx, 1> ys_ = Eigen::Matrix<double, Nx, 1>::Zero();  // its solution
   detail::QpMinNormWorkspace<capacity(max_task_rows), Nx> ls_ws_;
   Result result_{};
+  // Budget bookkeeping (HqpSettings::budget_us / budget_iterations).
+  std::chrono::steady_clock::time_point solve_start_{};
+  int iterations_used_ = 0;
+  std::array<double, sizeof...(Levels)> last_time_us_{};
+  std::array<int, sizeof...(Levels)> last_iterations_{};
 };
 
 }  // namespace hqp

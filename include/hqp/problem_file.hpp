@@ -314,7 +314,7 @@ std::vector<ProblemInstance<Wbc>> decodeProblemFile(const std::string& data, con
     return v;
   };
   const auto status = [&](int v, std::size_t s) {
-    if (v < 0 || v > static_cast<int>(QpStatus::InvalidInput))
+    if (v < 0 || v > static_cast<int>(QpStatus::BudgetCut))
       r.fail("instance " + std::to_string(s) + ": bad status " + std::to_string(v));
     return static_cast<QpStatus>(v);
   };

@@ -12,6 +12,9 @@ enum class QpStatus : int {
                      // (feasibility / stationarity); x() is finite but not a solution
   InvalidInput,      // the input breaks the contract (NaN, ±inf data, a bound of +inf as lower or
                      // −inf as upper, a magnitude above QpSettings::max_magnitude); x() is 0
+  BudgetCut,         // HqpWbc only: the per-solve budget (HqpSettings::budget_us / budget_iterations)
+                     // ran out before this level; it and every lower level were skipped and x()
+                     // is the higher levels' solution, completed with minimum norm
 };
 
 inline const char* toString(QpStatus s) {
@@ -21,6 +24,7 @@ inline const char* toString(QpStatus s) {
     case QpStatus::IterationLimit: return "IterationLimit";
     case QpStatus::NumericalFailure: return "NumericalFailure";
     case QpStatus::InvalidInput: return "InvalidInput";
+    case QpStatus::BudgetCut: return "BudgetCut";
   }
   return "Unknown";
 }

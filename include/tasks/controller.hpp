@@ -202,7 +202,8 @@ class Controller {
   }
 
   // Level 1 (the dynamics) must be optimal; lower levels may stop at their iteration cap
-  // (their iterate is feasible and higher levels are kept); a numerical failure or invalid
+  // (their iterate is feasible and higher levels are kept) or be cut by the budget (never
+  // level 1); a numerical failure or invalid
   // input anywhere, a higher level degraded by the lower ones (numerical health) or a
   // non-finite x is a failure.
   bool solutionUsable(const VectorX& x) const {
@@ -217,9 +218,12 @@ class Controller {
   void recordSolver(QpStatus status) {
     diag_.status = status;
     diag_.higher_level_degraded = false;
+    diag_.cut_level = -1;
     if (config_.solver == Config::Solver::Hqp) {
       const auto& r = hqp_.result();
       diag_.higher_level_degraded = r.higher_level_degraded;
+      diag_.cut_level = r.cut_level;
+      if (r.cut_level >= 0) ++diag_.budget_cuts;
       for (int p = 0; p < num_levels; ++p) {
         const auto& src = r.levels[p];
         auto& dst = diag_.levels[p];

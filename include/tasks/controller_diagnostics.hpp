@@ -70,6 +70,10 @@ struct ControllerDiagnostics {
   // HqpWbc's numerical health: some level's residual was raised beyond tolerance by the lower
   // levels (HqpResult::higher_level_degraded); the tick counts as a solver failure.
   bool higher_level_degraded = false;
+  // HqpWbc's per-tick budget (qp.hqp.budget_us / budget_iterations): the first level it cut this
+  // tick (−1: none; that level and all below have status BudgetCut), and the ticks cut so far.
+  int cut_level = -1;
+  long budget_cuts = 0;
   std::array<LevelDiagnostics<MaxActive>, NumLevels> levels{};
   std::array<bool, NumContacts> in_contact{};       // estimator: F/T normal force above threshold
   std::array<bool, NumContacts> following{};        // planner: ZMP in the safe region (Sec. III-A)

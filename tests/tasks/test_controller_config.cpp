@@ -267,11 +267,22 @@ TEST(ControllerConfig, QpSectionDefaultsAreTheSolversDefaults) {
   EXPECT_EQ(c.qp.hqp.warm_start, h.warm_start);
   EXPECT_EQ(c.qp.hqp.dual_last_level, h.dual_last_level);
   EXPECT_EQ(c.qp.hqp.residual_rise_tol, h.residual_rise_tol);
+  EXPECT_EQ(c.qp.hqp.budget_us, 0.0);  // no budget unless asked for
+  EXPECT_EQ(c.qp.hqp.budget_iterations, 0);
   EXPECT_TRUE(c.qp.wqp_warm_start);
   EXPECT_TRUE(c.qp.wqp_dual_method);
   EditedConfig seven("max_iterations: 100", "max_iterations: 7");
   ASSERT_TRUE(seven.found());
   EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(seven.path()).qp.hqp.qp.max_iterations, 7);
+}
+
+TEST(ControllerConfig, BudgetKeysSetTheSolversBudget) {
+  EditedConfig us("budget_us: 0 ", "budget_us: 250.5 ");
+  ASSERT_TRUE(us.found());
+  EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(us.path()).qp.hqp.budget_us, 250.5);
+  EditedConfig it("budget_iterations: 0 ", "budget_iterations: 40 ");
+  ASSERT_TRUE(it.found());
+  EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(it.path()).qp.hqp.budget_iterations, 40);
 }
 
 TEST(ControllerConfig, BadQpValuesNameTheKey) {
@@ -281,6 +292,10 @@ TEST(ControllerConfig, BadQpValuesNameTheKey) {
   expectRejected("level_rank_tol: 1.0e-9", "level_rank_tol: 2", "qp.hqp.level_rank_tol");
   expectRejected("residual_rise_tol: 1.0e-6", "residual_rise_tol: .nan", "qp.hqp.residual_rise_tol");
   expectRejected("max_magnitude: 1.0e50", "max_magnitude: 1.0e200", "qp.hqp.max_magnitude");
+  expectRejected("budget_us: 0 ", "budget_us: -1 ", "qp.hqp.budget_us");
+  expectRejected("budget_us: 0 ", "budget_us: .inf ", "qp.hqp.budget_us");
+  expectRejected("budget_iterations: 0 ", "budget_iterations: 1.5 ", "qp.hqp.budget_iterations");
+  expectRejected("budget_iterations: 0 ", "budget_iterations: -3 ", "qp.hqp.budget_iterations");
   expectRejected("    dual_method: true", "    dual_method: sometimes", "qp.wqp.dual_method");
   expectRejected("    dual_method: true", "    dual_methods: true", "qp.wqp.dual_methods");
   expectRejected("    warm_start: true          #", "    warmstart: true          #", "qp.hqp.warmstart");
