@@ -3,6 +3,7 @@
 # Idempotent: skips the install when every package is already present.
 # --demo adds what only the MuJoCo demo needs (ffmpeg for the MP4); --fuzz adds clang-14 and
 # its libFuzzer/sanitizer runtimes for tests/fuzz (scripts/fuzz.sh; scripts/test.sh runs them).
+# --rt adds cyclictest (rt-tests) and stress-ng for the jitter measurements of docs/realtime.md.
 set -euo pipefail
 
 PACKAGES=(
@@ -18,6 +19,7 @@ for arg in "$@"; do
   case "$arg" in
     --demo) PACKAGES+=(ffmpeg) ;;
     --fuzz) PACKAGES+=(clang-14 libclang-rt-14-dev llvm-14) ;;
+    --rt) PACKAGES+=(rt-tests stress-ng) ;;
     *) echo "setup: unknown option $arg" >&2; exit 2 ;;
   esac
 done

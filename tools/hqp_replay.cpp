@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -116,9 +117,17 @@ int main(int argc, char** argv) {
   }
   long differ = 0, active_differ = 0;
   double worst = 0.0;
+  // The worst case over the file (docs/realtime.md): QP iterations per level and solve time.
+  std::array<int, Replay::num_levels> max_iter{}, max_iter_rec{};
+  std::vector<double> times;
   for (std::size_t k = 0; k < instances.size(); ++k) {
     const Outcome o = replay(*wbc, instances[k], cold);
     worst = std::max(worst, o.dx);
+    times.push_back(o.time_us);
+    for (int p = 0; p < Replay::num_levels; ++p) {
+      max_iter[p] = std::max(max_iter[p], wbc->result().levels[p].iterations);
+      max_iter_rec[p] = std::max(max_iter_rec[p], instances[k].result.levels[p].iterations);
+    }
     if (!o.active_same) ++active_differ;
     if (o.dx > tol || !o.status_same) {
       ++differ;
@@ -129,5 +138,12 @@ int main(int argc, char** argv) {
   }
   std::printf("%zu instances replayed %s: %ld differ beyond %.1e (largest |dx| %.3g), %ld with another active set\n",
               instances.size(), cold ? "cold" : "warm", differ, tol, worst, active_differ);
+  std::printf("QP iterations per level, max over instances (replayed / recorded; cap %d per QP solve):",
+              info.settings.qp.max_iterations);
+  for (int p = 0; p < Replay::num_levels; ++p) std::printf(" L%d %d/%d", p + 1, max_iter[p], max_iter_rec[p]);
+  std::sort(times.begin(), times.end());
+  if (!times.empty())
+    std::printf("\nsolve time (us): median %.1f, p99 %.1f, max %.1f\n", times[times.size() / 2],
+                times[std::min(times.size() - 1, times.size() * 99 / 100)], times.back());
   return differ == 0 ? 0 : 1;
 }

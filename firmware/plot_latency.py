@@ -1,0 +1,119 @@
+#!/usr/bin/env python3
+"""Histograms of hqp_rt_loop tick samples (rt_ticks.csv): wake-up latency and compute time,
+with cyclictest's latency histograms alongside, and the markdown table of docs/realtime.md.
+
+usage: plot_latency.py OUT.png LABEL=rt_ticks.csv [...] [--cyclictest LABEL=histfile ...]
+
+A cyclictest histogram is the file of `cyclictest -h N --histfile=FILE` (1 µs bins).
+"""
+import math
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def read_ticks(path):
+    wake, compute, rt = [], [], True
+    with open(path) as f:
+        for line in f:
+            if line.startswith("#"):
+                rt = rt and "NOT RT" not in line
+                continue
+            if line.startswith("tick"):
+                continue
+            c = line.split(",")
+            wake.append(float(c[1]))
+            compute.append(float(c[2]))
+    return wake, compute, rt
+
+
+def read_cyclictest(path):
+    """cyclictest -h histogram: lines 'us count' (one thread), comments start with #."""
+    us, counts = [], []
+    with open(path) as f:
+        for line in f:
+            if line.startswith("#") or not line.strip():
+                continue
+            c = line.split()
+            if len(c) >= 2 and c[0].isdigit():
+                us.append(int(c[0]))
+                counts.append(int(c[1]))
+    return us, counts
+
+
+def quantiles_of_samples(v):
+    v = sorted(v)
+    q = lambda p: v[min(len(v) - 1, max(0, math.ceil(p * len(v)) - 1))]
+    return v[0], sum(v) / len(v), q(0.99), q(0.999), v[-1], len(v)
+
+
+def quantiles_of_histogram(us, counts):
+    n = sum(counts)
+    nz = [u for u, c in zip(us, counts) if c > 0]
+
+    def q(p):
+        k, acc = math.ceil(p * n), 0
+        for u, c in zip(us, counts):
+            acc += c
+            if acc >= k:
+                return u
+        return us[-1]
+
+    return nz[0], sum(u * c for u, c in zip(us, counts)) / n, q(0.99), q(0.999), nz[-1], n
+
+
+def table(loops, cyclic):
+    print("| source | samples | min | mean | p99 | p99.9 | max |")
+    print("|---|---|---|---|---|---|---|")
+    for label, path in cyclic:
+        mn, mean, p99, p999, mx, n = quantiles_of_histogram(*read_cyclictest(path))
+        print(f"| cyclictest, {label} | {n} | {mn} | {mean:.1f} | {p99} | {p999} | {mx} |")
+    for label, path in loops:
+        wake, compute, rt = read_ticks(path)
+        tag = "" if rt else " (NOT RT)"
+        for what, v in (("wake-up", wake), ("compute", compute)):
+            mn, mean, p99, p999, mx, n = quantiles_of_samples(v)
+            print(f"| rt_loop {what}, {label}{tag} | {n} | {mn:.1f} | {mean:.1f} | {p99:.1f} | {p999:.1f} | {mx:.1f} |")
+
+
+def main(argv):
+    if len(argv) < 3:
+        print(__doc__)
+        return 2
+    out, loops, cyclic, target = argv[1], [], [], None
+    for a in argv[2:]:
+        if a == "--cyclictest":
+            target = cyclic
+            continue
+        label, path = a.split("=", 1)
+        (target if target is not None else loops).append((label, path))
+    table(loops, cyclic)
+    fig, (ax_w, ax_c) = plt.subplots(1, 2, figsize=(12, 4.5))
+    for label, path in loops:
+        wake, compute, rt = read_ticks(path)
+        tag = "" if rt else " (NOT RT)"
+        ax_w.hist(wake, bins=200, histtype="step", log=True, label=f"rt_loop {label}{tag}")
+        ax_c.hist(compute, bins=200, histtype="step", log=True, label=f"{label}{tag}")
+    for label, path in cyclic:
+        us, counts = read_cyclictest(path)
+        ax_w.step(us, [max(c, 0.5) for c in counts], where="mid", label=f"cyclictest {label}")
+    ax_w.set_yscale("log")
+    ax_w.set_xlabel("wake-up latency (µs)")
+    ax_w.set_ylabel("ticks")
+    ax_w.set_title("Wake-up latency at 1 kHz")
+    ax_w.legend(fontsize=8)
+    ax_c.set_xlabel("Controller::tick compute time (µs)")
+    ax_c.set_ylabel("ticks")
+    ax_c.set_title("Compute time per tick")
+    ax_c.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    print(f"wrote {out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
