@@ -4,9 +4,17 @@
 // frame is a seqlock (odd sequence = being written; a reader that sees the sequence change
 // retries) and carries a checksum of its payload, so a torn frame could not pass unnoticed.
 // Lockstep: the plant publishes sensor frame k, the controller answers with command frame k,
-// the plant applies it, steps 1 ms and publishes sensor frame k + 1.
+// the plant applies it, steps 1 ms and publishes sensor frame k + 1. A side that has to wait
+// sleeps on a doorbell (a futex the writer rings after each frame) instead of polling: polling
+// with short sleeps costs a whole CPU and gets a SCHED_FIFO process throttled by the kernel.
+
+#include <linux/futex.h>
+#include <sys/syscall.h>
+#include <time.h>
+#include <unistd.h>
 
 #include <atomic>
+#include <climits>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -59,6 +67,23 @@ struct SeqFrame {
   }
 };
 
+// A counter the writer increments after each frame and wakes the other process on.
+struct Doorbell {
+  std::atomic<std::uint32_t> count{0};
+  static_assert(sizeof(std::atomic<std::uint32_t>) == sizeof(std::uint32_t), "a futex word");
+
+  std::uint32_t value() const { return count.load(std::memory_order_acquire); }
+  void ring() {
+    count.fetch_add(1, std::memory_order_release);
+    syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(&count), FUTEX_WAKE, INT_MAX, nullptr, nullptr, 0);
+  }
+  // Sleeps while the count is still `seen` (read before checking the frame), at most timeout_ns.
+  void wait(std::uint32_t seen, long timeout_ns) {
+    timespec t{timeout_ns / 1000000000, timeout_ns % 1000000000};
+    syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(&count), FUTEX_WAIT, seen, &t, nullptr, 0);
+  }
+};
+
 struct ProcessImage {
   static constexpr std::uint64_t kMagic = 0x4851505f52544931ull;  // "HQP_RTI1"
   std::atomic<std::uint64_t> magic{0};  // set by the plant once frame 0 is published
@@ -67,6 +92,7 @@ struct ProcessImage {
   std::atomic<std::uint64_t> plant_retries{0};  // command reads that met a write in progress
   SeqFrame<Sensors> sensors;
   SeqFrame<Command> command;
+  Doorbell sensors_bell, command_bell;
 };
 
 }  // namespace hqp::firmware

@@ -25,7 +25,7 @@ namespace fw = hqp::firmware;
 
 namespace {
 
-// Sleeps `ns` (relative): how a waiting side yields the CPU without a lock.
+// Sleeps `ns` (relative): while waiting for the plant process to appear.
 void pause(long ns) {
   timespec t{0, ns};
   clock_nanosleep(CLOCK_MONOTONIC, 0, &t, nullptr);
@@ -60,6 +60,7 @@ class ShmBackend {
   bool read(long k, fw::Sensors& s) {
     const std::int64_t until = fw::nowNs() + 1'000'000'000;
     for (bool first = true;; first = false) {
+      const std::uint32_t seen = img_->sensors_bell.value();
       std::uint64_t frame = 0;
       bool torn = false;
       if (img_->sensors.read(s, frame, torn)) {
@@ -72,12 +73,17 @@ class ShmBackend {
       }
       if (first) ++late_;
       if (fw::nowNs() > until || fw::g_stop_requested.load(std::memory_order_relaxed)) return false;
-      pause(5'000);
+      img_->sensors_bell.wait(seen, 10'000'000);
     }
   }
-  void write(long k, const fw::Command& c) { img_->command.write(c, static_cast<std::uint64_t>(k)); }
+  void write(long k, const fw::Command& c) {
+    img_->command.write(c, static_cast<std::uint64_t>(k));
+    img_->command_bell.ring();
+  }
   void finish() {
-    if (img_) img_->stop.store(1, std::memory_order_release);
+    if (!img_) return;
+    img_->stop.store(1, std::memory_order_release);
+    img_->command_bell.ring();
   }
   long late() const { return late_; }
   long retries() const { return retries_; }
@@ -260,7 +266,11 @@ int main(int argc, char** argv) {
   if (!out_dir.empty()) {
     std::filesystem::create_directories(out_dir);
     if (std::FILE* f = std::fopen((out_dir + "/rt_ticks.csv").c_str(), "w")) {
-      std::fprintf(f, "# %s", summary.c_str());
+      for (std::size_t a = 0, b; a < summary.size(); a = b + 1) {  // the summary as # lines
+        b = summary.find('\n', a);
+        if (b == std::string::npos) b = summary.size();
+        std::fprintf(f, "# %s\n", summary.substr(a, b - a).c_str());
+      }
       std::fprintf(f, "tick,wake_us,compute_us,io_us\n");
       const long first = loop.ticks() - static_cast<long>(samples.size());
       for (std::size_t i = 0; i < samples.size(); ++i)

@@ -76,6 +76,7 @@ int main(int argc, char** argv) {
     clock_gettime(CLOCK_MONOTONIC, &last);
     bool got = false;
     while (!got) {
+      const std::uint32_t seen = img->command_bell.value();
       std::uint64_t frame = 0;
       bool torn = false;
       if (img->command.read(cmd, frame, torn)) {
@@ -96,8 +97,7 @@ int main(int argc, char** argv) {
         rc = 1;
         break;
       }
-      timespec t{0, 5'000};
-      clock_nanosleep(CLOCK_MONOTONIC, 0, &t, nullptr);
+      img->command_bell.wait(seen, 10'000'000);
     }
     if (!got) break;
     if (!record.empty()) log.push_back({s, cmd});
@@ -105,6 +105,7 @@ int main(int argc, char** argv) {
     sim.step();
     sim.readSensors(s);
     img->sensors.write(s, static_cast<std::uint64_t>(k + 1));
+    img->sensors_bell.ring();
   }
   std::printf("rt_plant: %ld frames, torso height %.3f m, pitch %.4f rad, torn command frames %lu\n", k,
               sim.torsoHeight(), sim.torsoPitch(), static_cast<unsigned long>(img->plant_torn.load()));
