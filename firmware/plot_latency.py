@@ -31,17 +31,21 @@ def read_ticks(path):
 
 
 def read_cyclictest(path):
-    """cyclictest -h histogram: lines 'us count' (one thread), comments start with #."""
-    us, counts = [], []
+    """cyclictest --histfile: lines 'us count' (one thread), then '# Avg Latencies', '# Max
+    Latencies' and '# Histogram Overflows' (samples beyond the last bin)."""
+    us, counts, info = [], [], {}
     with open(path) as f:
         for line in f:
-            if line.startswith("#") or not line.strip():
+            if line.startswith("#"):
+                if ":" in line:
+                    k, v = line[1:].split(":", 1)
+                    info[k.strip()] = v.strip()
                 continue
             c = line.split()
             if len(c) >= 2 and c[0].isdigit():
                 us.append(int(c[0]))
                 counts.append(int(c[1]))
-    return us, counts
+    return us, counts, info
 
 
 def quantiles_of_samples(v):
@@ -50,8 +54,11 @@ def quantiles_of_samples(v):
     return v[0], sum(v) / len(v), q(0.99), q(0.999), v[-1], len(v)
 
 
-def quantiles_of_histogram(us, counts):
-    n = sum(counts)
+def quantiles_of_histogram(us, counts, info):
+    """Min, mean, p99, p99.9, max: mean and max as cyclictest reports them (the overflows beyond
+    the last bin are counted in n; a quantile among them reads '>' the last bin)."""
+    over = int(info.get("Histogram Overflows", "0"))
+    n = sum(counts) + over
     nz = [u for u, c in zip(us, counts) if c > 0]
 
     def q(p):
@@ -59,10 +66,10 @@ def quantiles_of_histogram(us, counts):
         for u, c in zip(us, counts):
             acc += c
             if acc >= k:
-                return u
-        return us[-1]
+                return str(u)
+        return f"> {us[-1]}"
 
-    return nz[0], sum(u * c for u, c in zip(us, counts)) / n, q(0.99), q(0.999), nz[-1], n
+    return nz[0], float(info["Avg Latencies"]), q(0.99), q(0.999), int(info["Max Latencies"]), n
 
 
 def table(loops, cyclic):
@@ -70,7 +77,7 @@ def table(loops, cyclic):
     print("|---|---|---|---|---|---|---|")
     for label, path in cyclic:
         mn, mean, p99, p999, mx, n = quantiles_of_histogram(*read_cyclictest(path))
-        print(f"| cyclictest, {label} | {n} | {mn} | {mean:.1f} | {p99} | {p999} | {mx} |")
+        print(f"| cyclictest, {label} | {n} | {mn} | {mean:.0f} | {p99} | {p999} | {mx} |")
     for label, path in loops:
         wake, compute, rt = read_ticks(path)
         tag = "" if rt else " (NOT RT)"
@@ -92,14 +99,28 @@ def main(argv):
         (target if target is not None else loops).append((label, path))
     table(loops, cyclic)
     fig, (ax_w, ax_c) = plt.subplots(1, 2, figsize=(12, 4.5))
+    # Log-spaced latency bins: the tail spans four decades on a shared VM.
+    top = 1.0
+    for label, path in loops:
+        top = max(top, max(read_ticks(path)[0]))
+    for label, path in cyclic:
+        top = max(top, float(read_cyclictest(path)[2]["Max Latencies"]))
+    edges = [10 ** (k / 40.0) for k in range(0, int(40 * math.log10(top)) + 2)]
     for label, path in loops:
         wake, compute, rt = read_ticks(path)
         tag = "" if rt else " (NOT RT)"
-        ax_w.hist(wake, bins=200, histtype="step", log=True, label=f"rt_loop {label}{tag}")
+        ax_w.hist(wake, bins=edges, histtype="step", log=True, label=f"rt_loop {label}{tag}")
         ax_c.hist(compute, bins=200, histtype="step", log=True, label=f"{label}{tag}")
     for label, path in cyclic:
-        us, counts = read_cyclictest(path)
-        ax_w.step(us, [max(c, 0.5) for c in counts], where="mid", label=f"cyclictest {label}")
+        us, counts, _ = read_cyclictest(path)  # 1 µs bins, regrouped into the same edges
+        regrouped = [0] * (len(edges) - 1)
+        for u, c in zip(us, counts):
+            for k in range(len(edges) - 1):
+                if edges[k] <= u + 0.5 < edges[k + 1]:
+                    regrouped[k] += c
+                    break
+        ax_w.stairs(regrouped, edges, label=f"cyclictest {label} (overflows beyond 2 ms not drawn)")
+    ax_w.set_xscale("log")
     ax_w.set_yscale("log")
     ax_w.set_xlabel("wake-up latency (µs)")
     ax_w.set_ylabel("ticks")

@@ -18,7 +18,8 @@ mkdir -p "$out"
 
 run() {  # $1: label (idle / loaded)
   local l=$1
-  { date -u; uptime; } > "$out/load_$l.txt"
+  # Load average, and the CPUs' steal time (jiffies the hypervisor ran something else).
+  { date -u; uptime; grep -E '^cpu[0-9]' /proc/stat; } > "$out/load_$l.txt"
   cyclictest -m -p $prio -a $cpu_loop -i 1000 -l $ticks -q -h 2000 --histfile="$out/cyclictest_$l.hist" \
     > "$out/cyclictest_$l.txt"
   "$build/sim_demo/hqp_rt_plant" --shm /hqp_rt_measure --cpu $cpu_plant --priority $((prio - 1)) \
@@ -27,7 +28,7 @@ run() {  # $1: label (idle / loaded)
   "$build/firmware/hqp_rt_loop" --backend shm --shm /hqp_rt_measure --ticks $ticks --priority $prio \
     --cpu $cpu_loop --out "$out/loop_$l" 2>&1 | tee "$out/loop_$l.txt"
   wait $plant
-  uptime >> "$out/load_$l.txt"
+  { uptime; grep -E '^cpu[0-9]' /proc/stat; } >> "$out/load_$l.txt"
 }
 
 run idle

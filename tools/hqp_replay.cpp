@@ -86,9 +86,11 @@ int main(int argc, char** argv) {
   long instance = -1;
   bool cold = false;
   double tol = 1e-9;
+  std::string csv;
   app.add_option("file", file, "recording (sim_demo --record)")->required();
   app.add_option("--instance", instance, "replay only instance K (0-based) and print it in detail");
   app.add_flag("--cold", cold, "start every level cold instead of from the recorded working sets");
+  app.add_option("--csv", csv, "write instance, QP iterations of each level, solve time (us) per instance here");
   app.add_option("--tol", tol, "largest accepted |x - x_rec|_inf / max(1, |x_rec|_inf)")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
@@ -120,10 +122,21 @@ int main(int argc, char** argv) {
   // The worst case over the file (docs/realtime.md): QP iterations per level and solve time.
   std::array<int, Replay::num_levels> max_iter{}, max_iter_rec{};
   std::vector<double> times;
+  std::FILE* out = csv.empty() ? nullptr : std::fopen(csv.c_str(), "w");
+  if (out) {
+    std::fprintf(out, "instance");
+    for (int p = 0; p < Replay::num_levels; ++p) std::fprintf(out, ",iterations_l%d", p + 1);
+    std::fprintf(out, ",time_us\n");
+  }
   for (std::size_t k = 0; k < instances.size(); ++k) {
     const Outcome o = replay(*wbc, instances[k], cold);
     worst = std::max(worst, o.dx);
     times.push_back(o.time_us);
+    if (out) {
+      std::fprintf(out, "%zu", k);
+      for (int p = 0; p < Replay::num_levels; ++p) std::fprintf(out, ",%d", wbc->result().levels[p].iterations);
+      std::fprintf(out, ",%.2f\n", o.time_us);
+    }
     for (int p = 0; p < Replay::num_levels; ++p) {
       max_iter[p] = std::max(max_iter[p], wbc->result().levels[p].iterations);
       max_iter_rec[p] = std::max(max_iter_rec[p], instances[k].result.levels[p].iterations);
@@ -138,6 +151,7 @@ int main(int argc, char** argv) {
   }
   std::printf("%zu instances replayed %s: %ld differ beyond %.1e (largest |dx| %.3g), %ld with another active set\n",
               instances.size(), cold ? "cold" : "warm", differ, tol, worst, active_differ);
+  if (out) std::fclose(out);
   std::printf("QP iterations per level, max over instances (replayed / recorded; cap %d per QP solve):",
               info.settings.qp.max_iterations);
   for (int p = 0; p < Replay::num_levels; ++p) std::printf(" L%d %d/%d", p + 1, max_iter[p], max_iter_rec[p]);

@@ -11,6 +11,7 @@
 //    residual (HqpWbc's residual is not larger than that optimum). Levels whose constraints
 //    HqpWbc reports dropped are solved without them; where the reference gives no answer,
 //    the comparison stops.
+#include <chrono>
 #include <memory>
 #include <random>
 #include <vector>
@@ -194,8 +195,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       impossible = impossible || l.lower(r) == hqp::fuzz::kInf || l.upper(r) == -hqp::fuzz::kInf;
     }
   }
+  const auto t0 = std::chrono::steady_clock::now();
   const QpStatus s = wbc.solve();
+  const double solve_us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
   const auto& res = wbc.result();
+  if (std::getenv("HQP_FUZZ_STATS")) {  // iterations per level and solve time over a corpus (docs/realtime.md)
+    std::fprintf(stderr, "stats:");
+    for (const auto& l : res.levels) std::fprintf(stderr, " %d", l.iterations);
+    std::fprintf(stderr, " %s %.2f\n", hqp::toString(s), solve_us);
+  }
   if (std::getenv("HQP_FUZZ_VERBOSE")) {
     std::fprintf(stderr, "finite %d inverted %d (largest crossing %.3g on a unit row) impossible %d status %s\n", finite,
                  inverted, crossing, impossible, hqp::toString(s));
