@@ -50,7 +50,8 @@ struct HqpSettings {
   // lower level are skipped and x keeps x*_{p−1} (their part of x is the minimum-norm
   // completion, 0 in the null space of the levels solved), if starting it would exceed a budget:
   //   elapsed µs since solve() began + the level's µs in the last solve that ran it > budget_us,
-  //   QP iterations so far + the level's iterations in that solve > budget_iterations.
+  //   QP iterations so far + the level's iterations in that solve > budget_iterations
+  // (each estimate halved on every solve that cut the level, so that it is tried again).
   // Level 0 is always solved. 0 (or any value not > 0) = no budget; off by default.
   double budget_us = 0.0;
   int budget_iterations = 0;
@@ -396,7 +397,13 @@ class HqpWbc {
   template <int P>
   void timedLevel() {
     const auto start = std::chrono::steady_clock::now();
-    if (result_.cut_level < 0 && P > 0 && overBudget(P, start)) result_.cut_level = P;
+    if (result_.cut_level < 0 && P > 0 && overBudget(P, start)) {
+      result_.cut_level = P;
+      // A cut level never refreshes its estimate: halve it, so that one slow solve cuts the
+      // level for a few ticks, not for ever.
+      last_time_us_[P] *= 0.5;
+      last_iterations_[P] /= 2;
+    }
     if (result_.cut_level >= 0) return skipLevel(P);
     solveLevel<P>();
     auto& lr = result_.levels[P];
@@ -408,7 +415,7 @@ class HqpWbc {
 
   // Would starting level p exceed the budget (HqpSettings::budget_us / budget_iterations)?
   // The level's cost is estimated by its cost in the last solve that ran it (warm-started
-  // levels cost about the same from tick to tick).
+  // levels cost about the same from tick to tick), halved on every solve that cut it.
   template <class TimePoint>
   bool overBudget(int p, TimePoint now) const {
     const std::size_t ps = static_cast<std::size_t>(p);

@@ -96,6 +96,7 @@ class Controller {
       lap = now;
     };
     diag_.time_us.fill(0.0);
+    diag_.cut_level = -1;  // set by recordSolver() on ticks that reach the solver
     ++diag_.ticks;
     const double dt = config_.dt;
 
