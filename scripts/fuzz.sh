@@ -29,15 +29,15 @@ else
   cmake --build "$build" -j"$(nproc)" --target "${fuzzers[@]}"
 fi
 
-status=0
-for f in "${fuzzers[@]}"; do
-  dir="$work/$f"
+# One fuzzer run: prepares its corpus, runs it, leaves log.txt and a one-line result in summary.txt.
+run_one() {
+  local f=$1 dir="$work/$1" pat p file runs secs execs findings rc start
   mkdir -p "$dir/corpus" "$dir/artifacts"
-  rm -f "$dir"/artifacts/*
+  rm -f "$dir"/artifacts/* "$dir/summary.txt"
   if [ $ci -eq 1 ]; then
     rm -rf "$dir/corpus" && mkdir -p "$dir/corpus"
   fi
-  python3 "$root/tests/fuzz/make_seeds.py" "$f" "$dir/corpus" 300
+  python3 "$root/tests/fuzz/make_seeds.py" "$f" "$dir/corpus" 300 >/dev/null
   if [ $ci -eq 1 ]; then
     # Every saved finding is replayed by the fuzzer(s) that decode it (docs/fuzzing.md).
     case "$f" in
@@ -48,7 +48,7 @@ for f in "${fuzzers[@]}"; do
       for file in "$root"/tests/fuzz/findings/$p; do [ -f "$file" ] && cp "$file" "$dir/corpus/finding_$(basename "$file")"; done
     done
   fi
-  opts=(-artifact_prefix="$dir/artifacts/" -print_final_stats=1 -max_len=4096)
+  local opts=(-artifact_prefix="$dir/artifacts/" -print_final_stats=1 -max_len=4096)
   [ "$f" = fuzz_urdf_generator ] && opts+=(-dict="$root/tests/fuzz/urdf.dict")
   if [ $ci -eq 1 ]; then
     # Deterministic: a count of runs, not a wall time (a slower machine must not reach other inputs).
@@ -68,8 +68,30 @@ for f in "${fuzzers[@]}"; do
   secs=$(( $(date +%s) - start ))
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$dir/log.txt" | tail -1)
   findings=$(find "$dir/artifacts" -type f | wc -l)
-  echo "== $f: ${execs:-?} executions in $secs s, corpus $(find "$dir/corpus" -type f | wc -l) files, findings $findings, exit code $rc"
-  if [ $rc -ne 0 ] || [ "$findings" -ne 0 ]; then
+  echo "$rc $findings == $f: ${execs:-?} executions in $secs s, corpus $(find "$dir/corpus" -type f | wc -l) files, findings $findings, exit code $rc" >"$dir/summary.txt"
+}
+
+# The CI regression runs the fuzzers side by side, one per core (each is single-threaded);
+# a timed campaign runs them one after the other so each gets its minutes of a whole core.
+parallel=1
+[ $ci -eq 1 ] && parallel=$(nproc)
+running=0
+for f in "${fuzzers[@]}"; do
+  run_one "$f" &
+  running=$((running + 1))
+  if [ $running -ge "$parallel" ]; then wait -n || true; running=$((running - 1)); fi
+done
+wait
+
+status=0
+for f in "${fuzzers[@]}"; do
+  dir="$work/$f"
+  if [ ! -f "$dir/summary.txt" ]; then
+    echo "== $f: did not run to the end (setting up its corpus failed)"; status=1; continue
+  fi
+  read -r rc findings line <"$dir/summary.txt"
+  echo "$line"
+  if [ "$rc" -ne 0 ] || [ "$findings" -ne 0 ]; then
     status=1
     grep -m3 -E "FUZZ FINDING|ERROR: AddressSanitizer|runtime error|ERROR: libFuzzer" "$dir/log.txt" | sed 's/^/   /' || true
     find "$dir/artifacts" -type f | sed 's/^/   input: /'

@@ -16,17 +16,22 @@ else
   cmake --build build-asan -j"$(nproc)" --target "${targets[@]}"
 fi
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-status=0
+# The binaries run side by side (each is single-threaded); results are printed in list order.
+log=build-asan/sanitize-logs
+mkdir -p "$log"
 for t in "${targets[@]}"; do
   bin=$(find build-asan/tests -type f -name "$t" -perm -u+x | head -1)
-  set +e
-  out=$("$bin" --gtest_brief=1 2>&1)
-  rc=$?
-  set -e
-  echo "== asan $t: $(echo "$out" | grep -E '^\[  (PASSED|FAILED) ' | tr '\n' ' ')exit code $rc"
-  if [ $rc -ne 0 ]; then
+  ( set +e; "$bin" --gtest_brief=1 >"$log/$t.txt" 2>&1; echo $? >"$log/$t.rc" ) &
+  while [ "$(jobs -rp | wc -l)" -ge "$(nproc)" ]; do wait -n || true; done
+done
+wait
+status=0
+for t in "${targets[@]}"; do
+  rc=$(cat "$log/$t.rc")
+  echo "== asan $t: $(grep -E '^\[  (PASSED|FAILED) ' "$log/$t.txt" | tr '\n' ' ')exit code $rc"
+  if [ "$rc" -ne 0 ]; then
     status=1
-    echo "$out" | grep -E "ERROR: AddressSanitizer|runtime error|FAILED" | head -5 | sed 's/^/   /'
+    grep -E "ERROR: AddressSanitizer|runtime error|FAILED" "$log/$t.txt" | head -5 | sed 's/^/   /'
   fi
 done
 exit $status
