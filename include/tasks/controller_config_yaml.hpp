@@ -257,7 +257,7 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
     const YAML::Node n = r.map(root, "", p, {"safe_margin", "com_height", "sole", "torso_yaw_offset",
                                             "follow_acceleration_cutoff", "follow_translation", "hold_tipping_axis",
                                             "com_reference_cutoff", "support_acceleration_from_estimator",
-                                            "follow_acceleration_order", "follow_acceleration_deadband"});
+                                            "follow_acceleration_order", "follow_acceleration_deadband", "hold_one_sided"});
     PlannerParameters& pl = c.planner;
     pl.safe_margin = r.atLeast(n, p, "safe_margin", 0.0, false);
     pl.com_height = r.finite(n, p, "com_height");
@@ -272,6 +272,8 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
       pl.follow_acceleration_cutoff = r.atLeast(n, p, "follow_acceleration_cutoff", 0.0, false);
     if (n["follow_translation"]) pl.follow_translation = r.boolean(n, p, "follow_translation");
     if (n["hold_tipping_axis"]) pl.hold_tipping_axis = r.boolean(n, p, "hold_tipping_axis");
+    if (n["hold_one_sided"]) pl.hold_one_sided = r.boolean(n, p, "hold_one_sided");
+    if (pl.hold_one_sided && !pl.hold_tipping_axis) r.fail("'planner.hold_one_sided' needs 'planner.hold_tipping_axis'");
     if (n["support_acceleration_from_estimator"])
       pl.support_acceleration_from_estimator = r.boolean(n, p, "support_acceleration_from_estimator");
     if (n["com_reference_cutoff"])
@@ -347,7 +349,8 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
       const std::string jp = r.join(p + ".joints", detail::ConfigReader::jointName<Robot>(j));
       const YAML::Node& e = js[static_cast<std::size_t>(j)];
       if (!e.IsMap()) r.fail("'" + jp + "' must be a map");
-      r.onlyKeys(e, jp, {"torque_constant", "current_limit", "coulomb", "viscous", "dq_star", "k_f", "k_dq"});
+      r.onlyKeys(e, jp, {"torque_constant", "current_limit", "coulomb", "viscous", "dq_star", "k_f", "k_dq",
+                         "leak_time"});
       c.joint.torque_constant[j] = r.atLeast(e, jp, "torque_constant", 0.0, true);
       c.joint.current_limit[j] = r.atLeast(e, jp, "current_limit", 0.0, true);
       JointFriction& f = c.joint.friction[static_cast<std::size_t>(j)];
@@ -356,6 +359,8 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
       f.dq_star = r.atLeast(e, jp, "dq_star", 0.0, true);
       c.joint.k_f[j] = r.atLeast(e, jp, "k_f", 0.0, false);
       c.joint.k_dq[j] = r.atLeast(e, jp, "k_dq", 0.0, false);
+      if (e["leak_time"])  // optional, beyond the paper: this joint's own leak of ∫q̈ dt
+        c.joint.joint_leak_time[j] = r.atLeast(e, jp, "leak_time", 0.0, false, /*allow_inf=*/true);
     }
   }
   {

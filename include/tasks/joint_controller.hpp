@@ -15,6 +15,9 @@
 //   2. q̇_des ← q̇_des + α (q̇ − q̇_des), α = 1 − exp(−dt / T_leak)
 // i.e. a first-order leak toward the measured velocity with time constant
 // T_leak (`leak_time`); T_leak = 0 or ∞ disables the leak (pure integral).
+// A joint may have its own T_leak (`joint_leak_time`, NaN = leak_time): on a moving
+// support the ankles turn at the support's rate, which ∫q̈* dt does not contain, and
+// eq. 7 needs that velocity's sign (docs/controller.md).
 // reset(q̇) sets q̇_des := q̇ (at start-up and when leaving safe mode).
 // The current is clamped to ±current_limit per joint (reported in status()).
 // A non-finite input (τ_opt, q̈*, q̇, dt) commands zero current, sets
@@ -41,6 +44,8 @@ struct JointControlParameters {
   VectorJ current_limit = VectorJ::Constant(std::numeric_limits<double>::infinity());  // A, > 0
   std::array<JointFriction, NJ> friction{};   // eq. 7 per joint
   double leak_time = 0.0;                     // s; 0 or ∞ = no leak
+  // s per joint, overriding leak_time; NaN = leak_time (beyond the paper, docs/controller.md)
+  VectorJ joint_leak_time = VectorJ::Constant(std::numeric_limits<double>::quiet_NaN());
 };
 
 // What the last compute() did.
@@ -78,9 +83,9 @@ class JointController {
       out.safe_mode = true;
       return;
     }
-    const double T = p_.leak_time;
-    const double alpha = (T > 0.0 && std::isfinite(T)) ? -std::expm1(-dt / T) : 0.0;
     for (int j = 0; j < NJ; ++j) {
+      const double T = std::isnan(p_.joint_leak_time[j]) ? p_.leak_time : p_.joint_leak_time[j];
+      const double alpha = (T > 0.0 && std::isfinite(T)) ? -std::expm1(-dt / T) : 0.0;
       double dq_des = dq_des_[j] + ddq_opt[j] * dt;
       dq_des += alpha * (dq_measured[j] - dq_des);
       const double tau_f = frictionTorque(p_.friction[static_cast<std::size_t>(j)], dq_des);  // eq. 7

@@ -16,7 +16,8 @@
 //   follow_translation: a foot in contact whose ZMP left the safe region keeps its orientation
 //     reference (the paper's hold, which stops a tipping foot) but its position, velocity and
 //     feed-forward acceleration references follow the foot's translation, so a board that
-//     carries the foot away is not fought by the level-2 task.
+//     carries the foot away is not fought by the level-2 task;
+//   hold_tipping_axis, hold_one_sided: what of the orientation is held (see PlannerParameters).
 // One extension beyond the paper for the CoM (docs/tasks.md, "CoM reference on moving supports";
 // off by default):
 //   com_reference_cutoff > 0: the CoM reference is the midpoint of the foot references after a
@@ -66,6 +67,12 @@ struct PlannerParameters {
   // yaw always (a foot cannot tip about its normal: holding yaw on a turning support makes it
   // twist on the support).
   bool hold_tipping_axis = false;
+  // With hold_tipping_axis: hold that axis only against tipping over the edge the ZMP is at, and
+  // follow the foot when it has turned the other way from the held orientation (a support that
+  // presses the sole flatter). On still ground the sole cannot turn that way, so this is the
+  // hold above; on a tilting support the hold no longer turns the ankle against the board,
+  // which pushed the CoP onto the edge that triggered it and kept it there (beyond the paper).
+  bool hold_one_sided = false;
   // Hz, low-pass of the feet's midpoint that the CoM reference follows; 0 = the midpoint itself.
   double com_reference_cutoff = 0.0;
   // The linear feed-forward acceleration of a following foot: false = the low-passed finite
@@ -142,12 +149,20 @@ class TaskPlanner {
         refs.contact_acceleration[c].template head<3>() = feed_forward_[c].template head<3>();
         if (params_.hold_tipping_axis) {
           // Sole-frame axes: hold x (roll) only near a y edge, y (pitch) only near an x edge.
-          const Eigen::Vector3d keep(insideBand(cop[c].y(), params_.sole_y_min, params_.sole_y_max) ? 1.0 : 0.0,
-                                     insideBand(cop[c].x(), params_.sole_x_min, params_.sole_x_max) ? 1.0 : 0.0,
-                                     1.0);
+          Eigen::Vector3d keep(insideBand(cop[c].y(), params_.sole_y_min, params_.sole_y_max) ? 1.0 : 0.0,
+                               insideBand(cop[c].x(), params_.sole_x_min, params_.sole_x_max) ? 1.0 : 0.0,
+                               1.0);
           const Eigen::Matrix3d R_held = refs.contact_pose[c].linear();
           const Eigen::AngleAxisd d(R_held.transpose() * X.linear());  // held -> measured, held frame
-          const Eigen::Vector3d e = keep.cwiseProduct(d.angle() * d.axis());
+          const Eigen::Vector3d turn = d.angle() * d.axis();
+          if (params_.hold_one_sided) {
+            // Tipping over the edge at ZMP p lifts the sole centre: (−ω × p)_z > 0, i.e. roll
+            // ω_x of sign −p_y (side edges), pitch ω_y of sign +p_x (toe, heel).
+            const double tip[2] = {cop[c].y() > 0.0 ? -1.0 : 1.0, cop[c].x() > 0.0 ? 1.0 : -1.0};
+            for (int k = 0; k < 2; ++k)
+              if (keep[k] == 0.0 && turn[k] * tip[k] < 0.0) keep[k] = 1.0;
+          }
+          const Eigen::Vector3d e = keep.cwiseProduct(turn);
           refs.contact_pose[c].linear() =
               R_held * (e.norm() > 0.0 ? Eigen::AngleAxisd(e.norm(), e / e.norm()).toRotationMatrix()
                                        : Eigen::Matrix3d::Identity());

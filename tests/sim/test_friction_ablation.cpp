@@ -109,7 +109,7 @@ double frictionEq7(double fc, double fv, double dq_star, double dq) {
 }
 
 struct JointYaml {
-  double k_dq, dq_star, coulomb, viscous, k_f;
+  double k_dq, dq_star, coulomb, viscous, k_f, leak;  // leak: the joint's own leak_time, else the global one
 };
 
 struct Case {
@@ -131,7 +131,8 @@ void checkJointLevel(const Case& c, double& max_error, double& max_tau_f, std::a
   for (int i = 0; i < kJoints; ++i) {
     const YAML::Node j = y["joints"][jointName(i)];
     joints.push_back({j["k_dq"].as<double>(), j["dq_star"].as<double>(), j["coulomb"].as<double>(),
-                      j["viscous"].as<double>(), j["k_f"].as<double>()});
+                      j["viscous"].as<double>(), j["k_f"].as<double>(),
+                      j["leak_time"] ? j["leak_time"].as<double>() : leak});
   }
   const YAML::Node plant = YAML::LoadFile(HQP_SIM_PLANT)["joints"];
 
@@ -144,7 +145,7 @@ void checkJointLevel(const Case& c, double& max_error, double& max_tau_f, std::a
   ASSERT_TRUE(driver);
   sim.reset();
   driver->reset();
-  const double dt = 0.001, alpha = 1.0 - std::exp(-dt / leak);
+  const double dt = 0.001;
   VectorJ dq_des = VectorJ::Zero();
   hqp::sim::Sensors s;
   hqp::sim::Command cmd;
@@ -159,7 +160,7 @@ void checkJointLevel(const Case& c, double& max_error, double& max_tau_f, std::a
     for (int i = 0; i < kJoints; ++i) {
       const JointYaml& j = joints[static_cast<std::size_t>(i)];
       dq_des[i] += t.ddq_opt[i] * dt;
-      dq_des[i] += alpha * (s.dq[i] - dq_des[i]);
+      dq_des[i] += (1.0 - std::exp(-dt / j.leak)) * (s.dq[i] - dq_des[i]);
       double fc = j.coulomb, fv = j.viscous;
       if (c.plant) {
         const YAML::Node pj = plant[jointName(i).substr(2)];

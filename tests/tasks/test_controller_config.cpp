@@ -186,8 +186,11 @@ TEST(ControllerConfig, NegativeOrInvalidValuesAreRejected) {
   expectRejected("  follow_acceleration_cutoff: 20", "  follow_acceleration_cutoff: -1",
                  "planner.follow_acceleration_cutoff");
   expectRejected("  follow_translation: true", "  follow_translation: maybe", "planner.follow_translation");
-  expectRejected("  follow_translation: true", "  follow_translation: true\n  follow_acceleration_order: 3",
+  expectRejected("  follow_acceleration_order: 2", "  follow_acceleration_order: 3",
                  "planner.follow_acceleration_order");
+  expectRejected("  hold_one_sided: true", "  hold_one_sided: yes please", "planner.hold_one_sided");
+  // The one-sided hold refines hold_tipping_axis and needs it.
+  expectRejected("  hold_tipping_axis: true", "  hold_tipping_axis: false", "planner.hold_one_sided");
   expectRejected("  follow_translation: true",
                  "  follow_translation: true\n  follow_acceleration_deadband: {linear: 0.5, angular: -1}",
                  "planner.follow_acceleration_deadband.angular");
@@ -196,16 +199,19 @@ TEST(ControllerConfig, NegativeOrInvalidValuesAreRejected) {
 // The feed-forward filter's stages and deadband reach the planner; absent, one stage and none.
 TEST(ControllerConfig, FeedForwardOrderAndDeadband) {
   const Config shipped = hqp::tasks::loadControllerConfig<Robot>(kYaml);
-  EXPECT_EQ(shipped.planner.follow_acceleration_order, 1);
+  EXPECT_EQ(shipped.planner.follow_acceleration_order, 2);
   EXPECT_EQ(shipped.planner.follow_acceleration_deadband_linear, 0.0);
   EditedConfig f("  follow_translation: true",
-                 "  follow_translation: true\n  follow_acceleration_order: 2\n"
+                 "  follow_translation: true\n"
                  "  follow_acceleration_deadband: {linear: 0.5, angular: 1.0}");
   ASSERT_TRUE(f.found());
   const Config c = hqp::tasks::loadControllerConfig<Robot>(f.path());
   EXPECT_EQ(c.planner.follow_acceleration_order, 2);
   EXPECT_EQ(c.planner.follow_acceleration_deadband_linear, 0.5);
   EXPECT_EQ(c.planner.follow_acceleration_deadband_angular, 1.0);
+  EditedConfig g("  follow_acceleration_order: 2", "  # (removed)");
+  ASSERT_TRUE(g.found());
+  EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(g.path()).planner.follow_acceleration_order, 1);
 }
 
 // The moving-support options are optional; without them the planner is the paper's rule.
@@ -219,6 +225,10 @@ TEST(ControllerConfig, MovingSupportOptionsDefaultToThePaperRule) {
   ASSERT_TRUE(g.found());
   EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(f.path()).planner.follow_acceleration_cutoff, 0.0);
   EXPECT_FALSE(hqp::tasks::loadControllerConfig<Robot>(g.path()).planner.follow_translation);
+  EXPECT_TRUE(shipped.planner.hold_one_sided);
+  EditedConfig o("  hold_one_sided: true", "  # (removed)");
+  ASSERT_TRUE(o.found());
+  EXPECT_FALSE(hqp::tasks::loadControllerConfig<Robot>(o.path()).planner.hold_one_sided);
   // The CoM extensions beyond the paper are off without their keys: the paper's PD.
   EditedConfig h("  com_schedule: {", "  # com_schedule: {");
   ASSERT_TRUE(h.found());
@@ -236,6 +246,26 @@ TEST(ControllerConfig, OtherSolverAndInfiniteLeakLoad) {
   ASSERT_TRUE(g.found());
   EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(g.path()).joint.leak_time,
             std::numeric_limits<double>::infinity());
+}
+
+// A joint's own leak time is optional: absent = the global leak_time (NaN in the parameters).
+TEST(ControllerConfig, PerJointLeakTime) {
+  const Config shipped = hqp::tasks::loadControllerConfig<Robot>(kYaml);
+  EditedConfig e("k_dq: 20}  # ratio 100", "k_dq: 20, leak_time: 0.05}  # ratio 100");
+  ASSERT_TRUE(e.found());  // the first knee entry: l_knee
+  const Config c = hqp::tasks::loadControllerConfig<Robot>(e.path());
+  const int knee = Robot::Joints::l_knee;
+  EXPECT_TRUE(std::isnan(shipped.joint.joint_leak_time[knee]));
+  EXPECT_EQ(c.joint.joint_leak_time[knee], 0.05);
+  for (int j = 0; j < Robot::nj; ++j)
+    if (j != knee) EXPECT_EQ(std::isnan(c.joint.joint_leak_time[j]), std::isnan(shipped.joint.joint_leak_time[j])) << j;
+  EditedConfig bad("k_dq: 20}  # ratio 100", "k_dq: 20, leak_time: -1}  # ratio 100");
+  try {
+    (void)hqp::tasks::loadControllerConfig<Robot>(bad.path());
+    ADD_FAILURE() << "negative leak_time accepted";
+  } catch (const std::exception& ex) {
+    EXPECT_NE(std::string(ex.what()).find("joint_control.joints.l_knee.leak_time"), std::string::npos) << ex.what();
+  }
 }
 
 // The shipped `qp` section holds the solvers' defaults (behaviour as without it), and a file

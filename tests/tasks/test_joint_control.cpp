@@ -120,6 +120,30 @@ TEST(JointController, LeakTowardMeasuredVelocity) {
   EXPECT_NEAR(jc.desiredVelocity()[1], -2.0 * (1.0 - std::exp(-1.0)), 1e-12);
 }
 
+// A joint's own leak time overrides the global one; NaN keeps the global one. Each joint is
+// an exact first-order lag toward q̇ with its own T: q̇_des(t) = q̇ (1 − exp(−t / T)).
+TEST(JointController, PerJointLeakTime) {
+  auto p = params();
+  p.leak_time = 0.5;
+  p.joint_leak_time << 0.05, std::numeric_limits<double>::quiet_NaN();
+  Controller2 jc;
+  jc.configure(p);
+  jc.reset(V2::Zero());
+  hqp::tasks::ActuatorCommand<2> out;
+  for (int k = 0; k < 100; ++k) jc.compute(V2::Zero(), V2::Zero(), V2(1.0, 1.0), 0.001, out);  // 0.1 s
+  EXPECT_NEAR(jc.desiredVelocity()[0], 1.0 - std::exp(-0.1 / 0.05), 1e-12);
+  EXPECT_NEAR(jc.desiredVelocity()[1], 1.0 - std::exp(-0.1 / 0.5), 1e-12);
+  // An infinite own leak time on joint 1 is the pure integral even with a global leak.
+  p.joint_leak_time << std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity();
+  jc.configure(p);
+  jc.reset(V2::Zero());
+  for (int k = 0; k < 100; ++k) jc.compute(V2::Zero(), V2(2.0, 2.0), V2::Zero(), 0.001, out);
+  // Joint 0: x' = a − x / T from 0, discretised exactly per step: x_n = a dt Σ_{i=1..n} r^i, r = e^{−dt/T}.
+  const double r = std::exp(-0.001 / 0.5);
+  EXPECT_NEAR(jc.desiredVelocity()[0], 2.0 * 0.001 * r * (1.0 - std::pow(r, 100)) / (1.0 - r), 1e-12);
+  EXPECT_NEAR(jc.desiredVelocity()[1], 0.2, 1e-12);
+}
+
 TEST(JointController, NoLeakIsPureIntegral) {
   for (double T : {0.0, std::numeric_limits<double>::infinity()}) {
     auto p = params();

@@ -365,3 +365,45 @@ TEST_F(Planner, HoldTippingAxisHoldsOnlyTheAxisOfTheNearEdge) {
     EXPECT_LT((refs.contact_pose[0].translation() - dyn.placement(0).translation()).norm(), 1e-12);
   }
 }
+
+// hold_one_sided: a held axis is held only against tipping over the edge the ZMP is at. Tipping
+// over a +y side edge is a negative roll, over the toe a positive pitch (the sole centre lifts);
+// a sole turned the other way from the held (level) orientation is followed.
+TEST_F(Planner, HoldOneSidedFollowsASoleTurnedAwayFromTipping) {
+  params.follow_translation = true;
+  params.hold_tipping_axis = true;
+  params.hold_one_sided = true;
+  struct Case {
+    Eigen::Vector3d axis;
+    double angle;
+    Eigen::Vector2d zmp;
+    bool followed;
+  };
+  const Case cases[] = {{Eigen::Vector3d::UnitX(), -0.05, {0.0, 0.045}, false},  // rolls over the +y edge: held
+                        {Eigen::Vector3d::UnitX(), 0.05, {0.0, 0.045}, true},    // pressed flatter: followed
+                        {Eigen::Vector3d::UnitX(), 0.05, {0.0, -0.045}, false},  // over the −y edge: held
+                        {Eigen::Vector3d::UnitX(), -0.05, {0.0, -0.045}, true},
+                        {Eigen::Vector3d::UnitY(), 0.05, {0.095, 0.0}, false},   // over the toe: held
+                        {Eigen::Vector3d::UnitY(), -0.05, {0.095, 0.0}, true},
+                        {Eigen::Vector3d::UnitY(), -0.05, {-0.095, 0.0}, false},  // over the heel: held
+                        {Eigen::Vector3d::UnitY(), 0.05, {-0.095, 0.0}, true}};
+  for (const Case& k : cases) {
+    planner.configure(params, Robot::total_mass);
+    at(crouch());
+    step(centre);
+    VectorQ q = crouch();
+    const Eigen::Quaterniond rot(Eigen::AngleAxisd(k.angle, k.axis));
+    q(3) = rot.w();
+    q.segment<3>(4) = rot.vec();
+    VectorV v = VectorV::Zero();
+    v.segment<3>(3) = (k.angle > 0.0 ? 0.3 : -0.3) * k.axis;
+    at(q, v);
+    step({k.zmp, Eigen::Vector2d::Zero()});
+    SCOPED_TRACE(testing::Message() << "axis " << k.axis.transpose() << " angle " << k.angle << ", ZMP " << k.zmp.transpose());
+    // The sole is level in the crouch, so the held orientation is the identity.
+    const Eigen::Matrix3d expected = k.followed ? Eigen::Matrix3d(dyn.placement(0).linear()) : Eigen::Matrix3d::Identity();
+    EXPECT_TRUE(refs.contact_pose[0].linear().isApprox(expected, 1e-9)) << refs.contact_pose[0].linear();
+    const Eigen::Vector3d w = dyn.velocity(0).tail<3>();
+    EXPECT_LT((refs.contact_velocity[0].tail<3>() - (k.followed ? w : Eigen::Vector3d::Zero())).norm(), 1e-9);
+  }
+}
