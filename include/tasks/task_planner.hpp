@@ -155,7 +155,7 @@ class TaskPlanner {
           const Eigen::Matrix3d R_held = refs.contact_pose[c].linear();
           const Eigen::AngleAxisd d(R_held.transpose() * X.linear());  // held -> measured, held frame
           const Eigen::Vector3d turn = d.angle() * d.axis();
-          if (params_.hold_one_sided) {
+          if (params_.hold_one_sided && cop[c].allFinite()) {  // no ZMP, no edge: hold both
             // Tipping over the edge at ZMP p lifts the sole centre: (−ω × p)_z > 0, i.e. roll
             // ω_x of sign −p_y (side edges), pitch ω_y of sign +p_x (toe, heel).
             const double tip[2] = {cop[c].y() > 0.0 ? -1.0 : 1.0, cop[c].x() > 0.0 ? 1.0 : -1.0};
