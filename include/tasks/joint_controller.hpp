@@ -83,9 +83,10 @@ class JointController {
       out.safe_mode = true;
       return;
     }
+    const auto leak = [dt](double T) { return (T > 0.0 && std::isfinite(T)) ? -std::expm1(-dt / T) : 0.0; };
+    const double alpha_all = leak(p_.leak_time);  // one expm1 per tick unless a joint has its own T
     for (int j = 0; j < NJ; ++j) {
-      const double T = std::isnan(p_.joint_leak_time[j]) ? p_.leak_time : p_.joint_leak_time[j];
-      const double alpha = (T > 0.0 && std::isfinite(T)) ? -std::expm1(-dt / T) : 0.0;
+      const double alpha = std::isnan(p_.joint_leak_time[j]) ? alpha_all : leak(p_.joint_leak_time[j]);
       double dq_des = dq_des_[j] + ddq_opt[j] * dt;
       dq_des += alpha * (dq_measured[j] - dq_des);
       const double tau_f = frictionTorque(p_.friction[static_cast<std::size_t>(j)], dq_des);  // eq. 7

@@ -257,8 +257,11 @@ TEST(ControllerConfig, PerJointLeakTime) {
   const int knee = Robot::Joints::l_knee;
   EXPECT_TRUE(std::isnan(shipped.joint.joint_leak_time[knee]));
   EXPECT_EQ(c.joint.joint_leak_time[knee], 0.05);
-  for (int j = 0; j < Robot::nj; ++j)
-    if (j != knee) EXPECT_EQ(std::isnan(c.joint.joint_leak_time[j]), std::isnan(shipped.joint.joint_leak_time[j])) << j;
+  for (int j = 0; j < Robot::nj; ++j) {
+    if (j != knee) {
+      EXPECT_EQ(std::isnan(c.joint.joint_leak_time[j]), std::isnan(shipped.joint.joint_leak_time[j])) << j;
+    }
+  }
   EditedConfig bad("k_dq: 20}  # ratio 100", "k_dq: 20, leak_time: -1}  # ratio 100");
   try {
     (void)hqp::tasks::loadControllerConfig<Robot>(bad.path());
