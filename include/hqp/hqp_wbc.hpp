@@ -55,6 +55,28 @@ struct HqpSettings {
   // Level 0 is always solved. 0 (or any value not > 0) = no budget; off by default.
   double budget_us = 0.0;
   int budget_iterations = 0;
+  // Per-level wall time (HqpLevelResult::time_us): two steady_clock reads per level. Off: no
+  // clock is read unless budget_us > 0 (the time budget needs the clock; budget_iterations
+  // does not), and time_us is 0. Compiling with HQP_NO_LEVEL_TIMING turns it off for good.
+  bool time_levels = true;
+  // KKT residuals of every level's QP (HqpLevelResult::kkt, docs/hqp.md, "Certificate"):
+  // O((task rows + active rows) · n + constraint rows) per level, no factorization. Off by
+  // default: a check for tests and diagnostics, not needed to use the answer. The multipliers
+  // themselves are always reported (they are a copy).
+  bool kkt_residuals = false;
+};
+
+// KKT residuals of one level's QP (docs/hqp.md, "Certificate"), in its variables u (x = x*_{p−1}
+// + Z u, Z orthonormal): min ½‖Â u − b̂‖², Â = W^½ A_p Z, b̂ = W^½ (b_p − A_p x*_{p−1}),
+// s.t. lower_i ≤ D_i x ≤ upper_i for the constraint rows i of levels ≤ p.
+struct HqpKkt {
+  bool computed = false;          // HqpSettings::kkt_residuals on and the level solved
+  // Stationarity ‖Âᵀ(Â u* − b̂) + Σ_a λ_a (D_a Z)ᵀ‖_∞, i.e. ‖Zᵀ(A_pᵀ W (A_p x*_p − b_p) + D_Wᵀ λ)‖_∞.
+  double stationarity = 0.0;
+  double stationarity_scale = 0.0;  // ‖Â‖_F ‖Â u* − b̂‖ + Σ_a |λ_a| ‖D_a Z‖: size of its terms
+  double primal = 0.0;           // max over rows of levels ≤ p of the bound violation at x*_p / ‖D_i‖
+  double dual = 0.0;             // max over active rows of the wrong-signed part of λ_a, times ‖D_a‖
+  double complementarity = 0.0;  // max over active rows of |λ_a (D_a x*_p − its bound)|
 };
 
 // What happened at one level; MaxActive = capacity of the stacked constraint rows.
@@ -73,11 +95,18 @@ struct HqpLevelResult {
   bool constraints_dropped = false;  // infeasible own constraints were dropped (no slack)
   bool slack_used = false;           // own constraints were relaxed minimally (slack option)
   double violation = 0.0;            // Σ over own rows of squared bound violation at x*
-  double time_us = 0.0;              // wall time of this level's solve (steady_clock), µs
+  double time_us = 0.0;              // wall time of this level's solve (steady_clock), µs;
+                                     // 0 with HqpSettings::time_levels off
   bool dual = false;                 // solved by DualActiveSetQp (HqpSettings::dual_last_level)
   // The level's residual at the final x rose beyond HqpSettings::residual_rise_tol above its
   // value at x*_p: the lower levels degraded it (numerical health, docs/hqp.md).
   bool degraded = false;
+  // Certificate: multiplier[a] is λ of active_row[a] in this level's QP (rows of this level and
+  // of higher ones), for the objective ½‖W^½(A_p x − b_p)‖²: Zᵀ(A_pᵀ W (A_p x*_p − b_p) +
+  // Σ_a λ_a D_aᵀ) = 0, λ_a ≥ 0 at an upper bound (active_upper), ≤ 0 at a lower bound. 0 unless
+  // the level's QP ended Optimal (free steps and levels without constraints have none).
+  std::array<double, MaxActive> multiplier{};
+  HqpKkt kkt{};                      // its residuals (HqpSettings::kkt_residuals)
 };
 // A level cut by the budget has status BudgetCut, iterations 0, and residual / objective at the
 // final x.
@@ -199,6 +228,8 @@ class HqpWbc {
   void setRankTolerance(double tol) { settings_.rank_tol = tol; }
   void setWarmStart(bool on) { settings_.warm_start = on; }
   void setDualLastLevel(bool on) { settings_.dual_last_level = on; }
+  void setLevelTiming(bool on) { settings_.time_levels = on; }    // HqpSettings::time_levels
+  void setKktResiduals(bool on) { settings_.kkt_residuals = on; }  // HqpSettings::kkt_residuals
   // Per-solve budget (HqpSettings::budget_us / budget_iterations; ≤ 0 = none).
   void setBudget(double us, int iterations) {
     settings_.budget_us = us;
@@ -216,7 +247,7 @@ class HqpWbc {
 
   // Solves the hierarchy; no heap, no exceptions, bounded by the QPs' iteration caps.
   QpStatus solve() noexcept {
-    solve_start_ = std::chrono::steady_clock::now();
+    if (settings_.budget_us > 0.0) solve_start_ = std::chrono::steady_clock::now();
     iterations_used_ = 0;
     result_.cut_level = -1;
     stackAll(std::make_index_sequence<sizeof...(Levels)>{});
@@ -263,6 +294,7 @@ class HqpWbc {
         result_.levels[static_cast<std::size_t>(p)].status = QpStatus::NumericalFailure;
     } else {
       checkHealth();
+      if (settings_.kkt_residuals) lastLevelPrimal();
     }
     result_.x = x_;
     return result_.status;
@@ -300,6 +332,11 @@ class HqpWbc {
   using VectorC = Eigen::Matrix<double, capacity(total_constraint_rows), 1>;
   using LeastSquares = std::conditional_t<(constraint_offset[1] == 0),
                                           Eigen::HouseholderQR<MatrixM>, detail::NoQp>;
+#ifdef HQP_NO_LEVEL_TIMING
+  static constexpr bool kLevelTiming = false;  // HqpSettings::time_levels is ignored
+#else
+  static constexpr bool kLevelTiming = true;
+#endif
 
   template <std::size_t... I>
   static std::tuple<LevelQp<static_cast<int>(I)>...> makeQps(const QpSettings& s,
@@ -393,10 +430,14 @@ class HqpWbc {
     (timedLevel<static_cast<int>(I)>(), ...);
   }
 
-  // Per-level wall time for diagnostics: two vDSO clock reads (~40 ns) per level.
+  // Per-level wall time for diagnostics: two vDSO clock reads (~40 ns) per level, only if
+  // time_levels is on or a time budget needs them.
   template <int P>
   void timedLevel() {
-    const auto start = std::chrono::steady_clock::now();
+    const bool timed = kLevelTiming && settings_.time_levels;
+    const bool clock = timed || settings_.budget_us > 0.0;
+    std::chrono::steady_clock::time_point start{};
+    if (clock) start = std::chrono::steady_clock::now();
     if (result_.cut_level < 0 && P > 0 && overBudget(P, start)) {
       result_.cut_level = P;
       // A cut level never refreshes its estimate: halve it, so that one slow solve cuts the
@@ -407,9 +448,13 @@ class HqpWbc {
     if (result_.cut_level >= 0) return skipLevel(P);
     solveLevel<P>();
     auto& lr = result_.levels[P];
-    lr.time_us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+    const double us =
+        clock ? std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start)
+                    .count()
+              : 0.0;
+    lr.time_us = timed ? us : 0.0;
     iterations_used_ += lr.iterations;
-    last_time_us_[P] = lr.time_us;  // the next solve's estimate of this level
+    last_time_us_[P] = us;  // the next solve's estimate of this level
     last_iterations_[P] = lr.iterations;
   }
 
@@ -491,6 +536,7 @@ class HqpWbc {
     if (n == 0) {
       // Nothing left to move: only check the level's own constraints at x*.
       if constexpr (own > 0) ownRowsWithoutFreedom<P>(lr);
+      lr.kkt.computed = settings_.kkt_residuals;  // no variables: stationarity is empty
       finishLevel<P>(lr, -bt_.template segment<r>(t0));
       return;
     }
@@ -536,6 +582,7 @@ class HqpWbc {
         u_.head(k) = ls_.solve(bq_);
       }
       lr.status = QpStatus::Optimal;
+      if (settings_.kkt_residuals) kktStationarity(lr, Aq_, bq_, u_, Aq_);  // no active row
     } else if (std::get<P>(qps_).numActive() == 0 && freeStep<P>(n, k, col0, rotated)) {
       // The unconstrained minimum-norm step meets every row: it is the QP's optimum with
       // an empty working set, so the QP (and the last level's rotation) is skipped. It is
@@ -544,6 +591,7 @@ class HqpWbc {
       // replays exactly (docs/recording.md).
       std::get<P>(qps_).resetWorkingSet();
       lr.status = QpStatus::Optimal;
+      if (settings_.kkt_residuals) kktStationarity(lr, Aq_, bq_, u_, Aq_);  // no active row
     } else {
       // The last level with Â_p of full column rank (no null space left, nothing truncated)
       // poses its QP in u itself: objective Â_p, constraint rows unrotated, u' = Qᵀ u after.
@@ -597,9 +645,14 @@ class HqpWbc {
       else if (lr.status == QpStatus::Optimal) lr.status = QpStatus::NumericalFailure;
       lr.num_active = std::min(qp.numActive(), max_active);
       for (int a = 0; a < lr.num_active; ++a) {
-        lr.active_row[static_cast<std::size_t>(a)] = qp.activeRow(a);
-        lr.active_upper[static_cast<std::size_t>(a)] = qp.activeAtUpper(a);
+        const std::size_t as = static_cast<std::size_t>(a);
+        lr.active_row[as] = qp.activeRow(a);
+        lr.active_upper[as] = qp.activeAtUpper(a);
+        lr.multiplier[as] = qp.activeAtUpper(a) ? qp.multiplier(a) : -qp.multiplier(a);
       }
+      // The QP's own data (u in its coordinates: u' or, direct, u) and its multipliers.
+      if (settings_.kkt_residuals && qp.x().size() == n)
+        kktStationarity(lr, qp.A(), qp.b(), qp.x(), qp.C());
     }
 
     // x*_p = x*_{p−1} + Z_{p−1} Q u' (eq. 4): update the reduced right-hand sides of every
@@ -675,9 +728,12 @@ class HqpWbc {
     lr.iterations = dual_.iterations();
     lr.num_active = std::min(dual_.numActive(), max_active);
     for (int a = 0; a < lr.num_active; ++a) {
-      lr.active_row[static_cast<std::size_t>(a)] = dual_.activeRow(a);
-      lr.active_upper[static_cast<std::size_t>(a)] = dual_.activeAtUpper(a);
+      const std::size_t as = static_cast<std::size_t>(a);
+      lr.active_row[as] = dual_.activeRow(a);
+      lr.active_upper[as] = dual_.activeAtUpper(a);
+      lr.multiplier[as] = dual_.activeAtUpper(a) ? dual_.multiplier(a) : -dual_.multiplier(a);
     }
+    if (settings_.kkt_residuals) kktStationarity(lr, M_, bq_, u_, Cw);
     // The level's ActiveSetQp starts from this active set if a later tick needs it.
     qp.resize(n, r, 0, c);
     qp.setWorkingSet(lr.num_active, lr.active_row.data(), lr.active_upper.data());
@@ -701,6 +757,62 @@ class HqpWbc {
     lr.residual = e.squaredNorm();
     lr.objective = (e.array().square() * w_.template segment<r>(t0).array()).sum();
     noteStatus(P, lr.status);
+    // dx_ = D x*_p here, except after the last level (not updated): see lastLevelPrimal().
+    if (lr.kkt.computed && P + 1 < num_levels) kktRows(lr, constraint_offset[P + 1], dx_);
+  }
+
+  // Certificate, stationarity (HqpKkt): s = Aᵀ(A u − b) + Σ_a λ_a C_aᵀ with the level's QP
+  // objective (A, b) and constraint rows C in its variables u. O((r + active rows) · n).
+  template <class MatA, class VecB, class VecU, class MatC>
+  void kktStationarity(HqpLevelResult<max_active>& lr, const MatA& A, const VecB& b,
+                       const VecU& u, const MatC& C) {
+    kkt_e_.noalias() = A * u;
+    kkt_e_ -= b;
+    kkt_s_.noalias() = A.transpose() * kkt_e_;
+    double scale = A.norm() * kkt_e_.norm();
+    for (int a = 0; a < lr.num_active; ++a) {
+      const double l = lr.multiplier[static_cast<std::size_t>(a)];
+      const auto c = C.row(lr.active_row[static_cast<std::size_t>(a)]);
+      kkt_s_ += l * c.transpose();
+      scale += std::abs(l) * c.norm();
+    }
+    lr.kkt.computed = true;
+    lr.kkt.stationarity = kkt_s_.size() > 0 ? kkt_s_.cwiseAbs().maxCoeff() : 0.0;
+    lr.kkt.stationarity_scale = scale;
+  }
+
+  // Certificate, rows (HqpKkt): primal feasibility of the rows [0, c) at d = D x*_p, the sign
+  // of each multiplier (dual feasibility) and complementarity, against the bounds the level
+  // solved with (its own rows dropped or relaxed if it was infeasible). O(c + active rows).
+  template <class Vec>
+  void kktRows(HqpLevelResult<max_active>& lr, int c, const Vec& d) {
+    double primal = 0.0, dual = 0.0, comp = 0.0;
+    for (int i = 0; i < c; ++i) {
+      const double v = std::max(lower_(i) - d(i), d(i) - upper_(i));
+      if (v > 0.0) primal = std::max(primal, v / rowScale(Dnorm_(i)));
+    }
+    for (int a = 0; a < lr.num_active; ++a) {
+      const std::size_t as = static_cast<std::size_t>(a);
+      const int j = lr.active_row[as];
+      const double l = lr.multiplier[as];
+      const bool up = lr.active_upper[as];
+      dual = std::max(dual, (up ? -l : l) * rowScale(Dnorm_(j)));  // λ ≥ 0 at upper, ≤ 0 at lower
+      comp = std::max(comp, std::abs(l * (d(j) - (up ? upper_(j) : lower_(j)))));
+    }
+    lr.kkt.primal = primal;
+    lr.kkt.dual = dual;
+    lr.kkt.complementarity = comp;
+  }
+
+  // The last level's rows at the final x (= x*_p of the last level; dx_ is not updated there).
+  void lastLevelPrimal() {
+    constexpr int c = total_constraint_rows;
+    auto& lr = result_.levels[static_cast<std::size_t>(num_levels - 1)];
+    if constexpr (c > 0) {
+      if (!lr.kkt.computed) return;
+      kkt_d_.template head<c>().noalias() = D_.template topRows<c>() * x_;
+      kktRows(lr, c, kkt_d_);
+    }
   }
 
   // The level's unconstrained minimum-norm step u' = [y; 0], y = argmin ‖L y − b'‖ with
@@ -931,6 +1043,9 @@ class HqpWbc {
   Eigen::Matrix<double, Nx, 1> ys_ = Eigen::Matrix<double, Nx, 1>::Zero();  // its solution
   detail::QpMinNormWorkspace<capacity(max_task_rows), Nx> ls_ws_;
   Result result_{};
+  VectorM kkt_e_;                // certificate scratch: A u − b
+  VectorU kkt_s_;                // its stationarity vector
+  VectorC kkt_d_ = VectorC::Zero();  // D x at the last level
   // Budget bookkeeping (HqpSettings::budget_us / budget_iterations).
   std::chrono::steady_clock::time_point solve_start_{};
   int iterations_used_ = 0;

@@ -11,6 +11,8 @@
 #include <tuple>
 #include <utility>
 
+#include "hqp/constraint.hpp"
+
 namespace hqp {
 
 template <class... Ts>
@@ -77,7 +79,9 @@ class Level<Nx, TaskList<Ts...>, ConstraintList<Cs...>, Slack> {
     stackTasksImpl(A, b, w, row0, std::index_sequence_for<Ts...>{});
   }
 
-  // Writes [D_p] into D.middleRows(row0, constraint_rows), the bounds likewise.
+  // Writes [D_p] into D.middleRows(row0, constraint_rows), the bounds likewise, each read by
+  // interpretBound (|bound| ≥ kInfBound is ±inf): the one place the hierarchies take bounds in,
+  // so everything downstream sees exactly what ±inf would give.
   template <class MatD, class VecL, class VecU>
   void stackConstraints(MatD& D, VecL& lower, VecU& upper, int row0) const {
     stackConstraintsImpl(D, lower, upper, row0, std::index_sequence_for<Cs...>{});
@@ -105,9 +109,9 @@ class Level<Nx, TaskList<Ts...>, ConstraintList<Cs...>, Slack> {
     static_cast<void>(row0);
     ((D.template middleRows<Cs::rows>(row0 + constraint_offsets[I]) = std::get<I>(constraints_).D,
       lower.template segment<Cs::rows>(row0 + constraint_offsets[I]) =
-          std::get<I>(constraints_).lower,
+          std::get<I>(constraints_).lower.unaryExpr([](double v) { return interpretBound(v); }),
       upper.template segment<Cs::rows>(row0 + constraint_offsets[I]) =
-          std::get<I>(constraints_).upper),
+          std::get<I>(constraints_).upper.unaryExpr([](double v) { return interpretBound(v); })),
      ...);
   }
 
