@@ -2,6 +2,8 @@
 // -fno-rtti. Solves a 3-level hierarchy whose strict solution is known in closed form.
 #include <cmath>
 
+// Per-level timing compiled out (time_us is 0 whatever HqpSettings::time_levels says).
+#define HQP_NO_LEVEL_TIMING
 #include "hqp/hqp_wbc.hpp"
 #include "hqp/wqp_wbc.hpp"
 
@@ -46,6 +48,18 @@ int main() {
   if (r.levels[1].num_active != 1 || r.levels[1].active_row[0] != 0 || !r.levels[1].active_upper[0])
     return 4;
   if (std::abs(r.levels[1].residual - (0.25 + 16.0)) > 1e-9) return 5;
+  for (const auto& lr : r.levels)
+    if (lr.time_us != 0.0) return 8;
+  // Certificate of level 2: ½((x2 − 1)² + (x0 − 5)²) over x2, x3 (x0, x1 fixed by level 1), with
+  // x2 ≤ 0.5 active: (x2 − 1) + λ = 0, λ = 0.5 ≥ 0 at the upper bound.
+  if (std::abs(r.levels[1].multiplier[0] - 0.5) > 1e-9) return 9;
+  g_hqp.setKktResiduals(true);
+  fill(g_hqp);
+  g_hqp.solve();
+  for (const auto& lr : r.levels)
+    if (!lr.kkt.computed || lr.kkt.stationarity > 1e-12 || lr.kkt.primal > 1e-12 ||
+        lr.kkt.dual > 0.0 || lr.kkt.complementarity > 1e-12)
+      return 10;
 
   // The weighted QP with a large ratio lands close to the strict solution.
   fill(g_wqp);

@@ -157,6 +157,70 @@ TEST(HqpBudget, LargeBudgetChangesNothing) {
   }
 }
 
+// HqpSettings::time_levels off: time_us is 0 on every level, and x, statuses, iterations and
+// active sets are bit for bit those of a timed solve (warm sequences included).
+TEST(HqpLevelTiming, OffGivesZeroTimesAndTheSameSolution) {
+  EXPECT_TRUE(hqp::HqpSettings{}.time_levels);
+  g_full.setBudget(0.0, 0);
+  g_plain.setBudget(0.0, 0);
+  g_full.setLevelTiming(false);
+  g_plain.setLevelTiming(true);
+  double timed = 0.0;
+  for (unsigned seed = 1; seed <= 20; ++seed) {
+    const Data d = makeData(seed);
+    g_full.resetWarmStart();
+    g_plain.resetWarmStart();
+    for (int tick = 0; tick < 3; ++tick) {
+      fill(g_full, d);
+      fill(g_plain, d);
+      const auto s = g_full.solve();
+      EXPECT_EQ(s, g_plain.solve()) << seed;
+      EXPECT_TRUE(g_full.x() == g_plain.x()) << seed;  // bit for bit
+      for (std::size_t p = 0; p < 3; ++p) {
+        const auto& a = g_full.result().levels[p];
+        const auto& b = g_plain.result().levels[p];
+        EXPECT_EQ(a.time_us, 0.0) << seed;
+        EXPECT_EQ(a.status, b.status) << seed;
+        EXPECT_EQ(a.iterations, b.iterations) << seed;
+        ASSERT_EQ(a.num_active, b.num_active) << seed;
+        for (int k = 0; k < a.num_active; ++k) EXPECT_EQ(a.active_row[k], b.active_row[k]) << seed;
+        timed += b.time_us;
+      }
+    }
+  }
+  EXPECT_GT(timed, 0.0);  // the timed solver does measure
+  g_full.setLevelTiming(true);
+}
+
+// The iteration budget needs no clock; the time budget still reads it (time_us stays 0).
+TEST(HqpLevelTiming, BudgetsWorkWithTimingOff) {
+  g_full.setLevelTiming(false);
+  for (unsigned seed = 1; seed <= 20; ++seed) {
+    const Data d = makeData(seed);
+    g_full.resetWarmStart();
+    g_top2.resetWarmStart();
+    g_full.setBudget(0.0, 1);
+    fill(g_full, d);
+    fill(g_top2, d);
+    g_full.solve();
+    ASSERT_EQ(g_top2.solve(), hqp::QpStatus::Optimal) << seed;
+    const auto& r = g_full.result();
+    ASSERT_GE(r.levels[1].iterations, 2) << seed;
+    EXPECT_EQ(r.cut_level, 2) << seed;
+    EXPECT_EQ(r.status, hqp::QpStatus::BudgetCut) << seed;
+    EXPECT_LE((g_full.x() - g_top2.x()).norm(), 1e-10 * (1.0 + g_top2.x().norm())) << seed;
+    // 1 ps: cut before level 1, and no level reports a time.
+    g_full.resetWarmStart();
+    g_full.setBudget(1e-6, 0);
+    fill(g_full, d);
+    EXPECT_EQ(g_full.solve(), hqp::QpStatus::BudgetCut) << seed;
+    EXPECT_EQ(r.cut_level, 1) << seed;
+    for (const auto& lr : r.levels) EXPECT_EQ(lr.time_us, 0.0) << seed;
+  }
+  g_full.setBudget(0.0, 0);
+  g_full.setLevelTiming(true);
+}
+
 TEST(HqpBudget, CutSolveDoesNotAllocate) {
   const Data d = makeData(3);
   g_full.setBudget(1e-6, 0);
