@@ -389,7 +389,7 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
       const YAML::Node m = r.map(n, "qp", "hqp",
                                  {"max_iterations", "feasibility_tol", "rank_tol", "dual_tol", "max_magnitude",
                                   "level_rank_tol", "warm_start", "dual_last_level", "residual_rise_tol",
-                                  "budget_us", "budget_iterations"});
+                                  "budget_us", "budget_iterations", "time_levels"});
       HqpSettings& h = c.qp.hqp;
       qpKeys(m, p, h.qp);
       if (m["level_rank_tol"]) h.rank_tol = r.tolerance(m, p, "level_rank_tol");
@@ -399,6 +399,8 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
       // Per-tick budget of the solve; 0 = none (HqpSettings::budget_us / budget_iterations).
       if (m["budget_us"]) h.budget_us = r.atLeast(m, p, "budget_us", 0.0, false);
       if (m["budget_iterations"]) h.budget_iterations = r.integer(m, p, "budget_iterations", 0, 1000000);
+      // Per-level wall time (HqpSettings::time_levels); off: no clock read unless budget_us is set.
+      if (m["time_levels"]) h.time_levels = r.boolean(m, p, "time_levels");
     }
     if (n["wqp"]) {
       const std::string p = "qp.wqp";

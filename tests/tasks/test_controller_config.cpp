@@ -316,6 +316,10 @@ TEST(ControllerConfig, BudgetKeysSetTheSolversBudget) {
   EditedConfig it("budget_iterations: 0 ", "budget_iterations: 40 ");
   ASSERT_TRUE(it.found());
   EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(it.path()).qp.hqp.budget_iterations, 40);
+  EXPECT_TRUE(hqp::tasks::loadControllerConfig<Robot>(kYaml).qp.hqp.time_levels);
+  EditedConfig tl("time_levels: true ", "time_levels: false ");
+  ASSERT_TRUE(tl.found());
+  EXPECT_FALSE(hqp::tasks::loadControllerConfig<Robot>(tl.path()).qp.hqp.time_levels);
 }
 
 TEST(ControllerConfig, BadQpValuesNameTheKey) {
@@ -329,6 +333,7 @@ TEST(ControllerConfig, BadQpValuesNameTheKey) {
   expectRejected("budget_us: 0 ", "budget_us: .inf ", "qp.hqp.budget_us");
   expectRejected("budget_iterations: 0 ", "budget_iterations: 1.5 ", "qp.hqp.budget_iterations");
   expectRejected("budget_iterations: 0 ", "budget_iterations: -3 ", "qp.hqp.budget_iterations");
+  expectRejected("time_levels: true ", "time_levels: often ", "qp.hqp.time_levels");
   expectRejected("    dual_method: true", "    dual_method: sometimes", "qp.wqp.dual_method");
   expectRejected("    dual_method: true", "    dual_methods: true", "qp.wqp.dual_methods");
   expectRejected("    warm_start: true          #", "    warmstart: true          #", "qp.hqp.warmstart");
