@@ -62,12 +62,12 @@ def med(w, name, key):
     v = [b[key] for run in runs[w] for b in run if b["name"] == name and key in b]
     return statistics.median(v) if v else float("nan")
 names = [b["name"] for b in runs["old"][0]]
-print(f"{'benchmark':44} {'counter':14} {'old':>10} {'new':>10} {'old/new':>8}")
+print(f"{'benchmark':49} {'counter':14} {'old':>10} {'new':>10} {'old/new':>8}")
 for n in names:
     keys = ["hqp_p50_us", "hqp_p99_us", "peer_p50_us"] if "Corpus" in n else ["real_time"]
     for k in keys:
         o, w = med("old", n, k), med("new", n, k)
-        print(f"{n:44} {k:14} {o:10.2f} {w:10.2f} {o / w:8.3f}")
+        print(f"{n.replace('/min_time:1.000', ''):49} {k:14} {o:10.2f} {w:10.2f} {o / w:8.3f}")
 PY
     rm -rf "$tmp"
     exit 0 ;;
