@@ -304,7 +304,7 @@ struct Tally {
 };
 
 Tally check(const std::vector<Instance>& v, const hqp::HqpSettings& settings, const std::string& name, double tol,
-            double obj_tol) {
+            double obj_tol, bool verbose) {
   Tally t;
   auto wbc = std::make_unique<Wbc>(settings);
   auto peer = std::make_unique<Peer>();
@@ -361,7 +361,10 @@ Tally check(const std::vector<Instance>& v, const hqp::HqpSettings& settings, co
     }
     const int c = compareLex(fw, levelObjectives(in, xp), obj_tol);
     if (c == 0) ++t.peer_equal;
-    else if (c < 0) ++t.hqp_better;
+    else if (c < 0) {
+      ++t.hqp_better;
+      if (verbose) t.notes.push_back(name + " instance " + std::to_string(k) + ": the peer ends lexicographically higher");
+    }
     else {
       ++t.peer_better;
       t.notes.push_back(name + " instance " + std::to_string(k) + ": the peer reaches a lexicographically lower objective");
@@ -370,7 +373,7 @@ Tally check(const std::vector<Instance>& v, const hqp::HqpSettings& settings, co
   return t;
 }
 
-int checkCommand(const std::string& dir, int max, double tol, double obj_tol) {
+int checkCommand(const std::string& dir, int max, double tol, double obj_tol, bool verbose) {
   std::printf("%-18s %5s %12s %12s %9s %9s %11s %11s %10s %10s %8s %8s %10s\n", "family", "inst", "optimal_warm",
               "optimal_cold", "warm=cold", "=stored", "stored_nopt", "peer_equal", "hqp_better", "peer_better",
               "peer_fail", "unique", "active");
@@ -387,7 +390,7 @@ int checkCommand(const std::string& dir, int max, double tol, double obj_tol) {
       continue;
     }
     if (max > 0 && static_cast<int>(v.size()) > max) v.resize(static_cast<std::size_t>(max));
-    const Tally t = check(v, info.settings, name, tol, obj_tol);
+    const Tally t = check(v, info.settings, name, tol, obj_tol, verbose);
     std::printf("%-18s %5d %12d %12d %9d %9d %11d %11d %10d %10d %8d %8d %10.1f\n", name, t.instances, t.status_warm,
                 t.status_cold, t.x_warm_cold, t.x_stored, t.stored_not_optimal, t.peer_equal, t.hqp_better,
                 t.peer_better, t.peer_failed, t.unique, t.active / std::max(1, t.instances));
@@ -395,7 +398,7 @@ int checkCommand(const std::string& dir, int max, double tol, double obj_tol) {
          t.peer_better == 0;
     notes.insert(notes.end(), t.notes.begin(), t.notes.end());
   }
-  for (std::size_t k = 0; k < notes.size() && k < 30; ++k) std::printf("  %s\n", notes[k].c_str());
+  for (std::size_t k = 0; k < notes.size() && (verbose || k < 30); ++k) std::printf("  %s\n", notes[k].c_str());
   std::printf("%s\n", ok ? "corpus check: all instances as expected" : "corpus check: MISMATCHES (above)");
   return ok ? 0 : 1;
 }
@@ -453,6 +456,8 @@ int main(int argc, char** argv) {
   chk->add_option("--max", max, "check at most this many instances per family (0: all)");
   chk->add_option("--tol", tol, "|x_warm - x_cold|_inf / max(1, |x_cold|_inf)")->capture_default_str();
   chk->add_option("--objective-tol", obj_tol, "relative tolerance of level objectives")->capture_default_str();
+  bool verbose = false;
+  chk->add_flag("--verbose", verbose, "also list the instances where the peer ends worse");
   std::string show_file;
   int show_k = 0;
   auto* shw = app.add_subcommand("show", "one instance in detail: warm, cold and the peer per level");
@@ -468,7 +473,7 @@ int main(int argc, char** argv) {
       return generate(seeds, scenarios, base, out, max_per_line);
     }
     if (*shw) return showCommand(show_file, show_k);
-    return checkCommand(dir, max, tol, obj_tol);
+    return checkCommand(dir, max, tol, obj_tol, verbose);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hqp_corpus: %s\n", e.what());
     return 2;
