@@ -1,7 +1,7 @@
 // The instance corpus (docs/benchmarks.md, "Instance corpus"): HqpWbc and the peer cascade
 // (peer_cascade.hpp, BM_PeerWarm's solver) on every instance of a family, alternately, warm
 // (each instance's recorded incoming working sets, given to both) or cold. Generate the
-// corpus first: bash scripts/make_corpus.sh (into build/corpus; HQP_CORPUS_DIR=path for
+// corpus first: bash scripts/corpus.sh make (into build/corpus; HQP_CORPUS_DIR=path for
 // another folder). Linked into bench_hqp, so BM_HqpWarm and BM_PeerWarm run in the same process:
 //   taskset -c 1 bench_hqp --benchmark_filter='Corpus|PeerWarm|HqpWarm/levels_1-4' \
 //       --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
@@ -59,7 +59,7 @@ const Family& family(const std::string& name) {
     f.instances = hqp::readProblemFile<Wbc>(path, &f.info);
     if (f.instances.empty()) f.error = path + ": no instances";
   } catch (const std::exception& e) {
-    f.error = std::string(e.what()) + " (generate the corpus: bash scripts/make_corpus.sh)";
+    f.error = std::string(e.what()) + " (generate the corpus: bash scripts/corpus.sh make)";
   }
   return cache.emplace(name, std::move(f)).first->second;
 }
