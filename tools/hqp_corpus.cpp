@@ -4,9 +4,11 @@
 //       seed-list order; DIR/stress.hqprec and DIR/degenerate.hqprec: instances derived from
 //       them by the seeded transformations of the list. --base FILE instead of --scenarios
 //       derives from one recording (the checked-in one, for the ctest).
-//   hqp_corpus check DIR [--max K]
-//       exactness: every instance warm and cold, statuses as stored, warm x* = cold x*, the
+//   hqp_corpus check DIR [--max K] [--verbose]
+//       exactness: every instance warm and cold, every level Optimal, warm x* = cold x*, the
 //       level objectives against the peer cascade (peer_cascade.hpp). Exit 1 on a mismatch.
+//   hqp_corpus show FILE K
+//       one instance per level: warm, cold and the peer (objective, status, iterations).
 // Deterministic: the random numbers come from std::mt19937_64 through our own uniform and
 // normal transforms (the standard distributions differ between standard libraries).
 // The shape is Walker3's balance hierarchy (Table I), as for hqp_replay.
