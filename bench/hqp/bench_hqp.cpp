@@ -3,7 +3,8 @@
 // active constraints. Reports cold and warm solves, per level (prefix hierarchies: the time
 // of level p = time(levels ≤ p) − time(levels < p)), WqpWbc, and a peer in the same binary:
 // the paper's literal projector cascade N_p = N_{p−1}(I − Â_p⁺ Â_p) on dynamic-size Eigen
-// (MatrixXd, Eigen's COD with allocation), every level's QP in all 30 variables.
+// (MatrixXd, Eigen's COD with allocation), every level's QP in all 30 variables
+// (peer_cascade.hpp, shared with the corpus benchmark and check).
 // Run: bench_hqp --benchmark_repetitions=10 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
@@ -15,6 +16,7 @@
 
 #include "hqp/hqp_wbc.hpp"
 #include "hqp/wqp_wbc.hpp"
+#include "peer_cascade.hpp"
 
 namespace {
 
@@ -269,74 +271,46 @@ void BM_WqpWarm(benchmark::State& state) {
   state.counters["failures"] = static_cast<double>(failures);
 }
 
-// ---- Peer: the literal projector cascade on dynamic-size Eigen ------------------------------
-// Level p: min_u ‖A_p (x + N u) − b_p‖² s.t. all constraints ≤ p on x + N u, u ∈ R^30;
-// then x += N u and N ← N (I − Â⁺ Â) with Â = A_p N, Â⁺ from Eigen's COD (allocates).
-// Same QP code (ActiveSetQp, one type sized for the largest level) but no null-space basis,
-// so every level's QP keeps 30 variables, and no preallocation of the cascade's matrices.
-class PeerCascade {
+// ---- Peer: the literal projector cascade on dynamic-size Eigen (peer_cascade.hpp) ----------
+// Each tick stacked once, outside the timed loop (as an instance of the corpus is).
+struct StackedTick {
+  Eigen::Matrix<double, 36, N> A;
+  Eigen::Matrix<double, 36, 1> b, w;
+  Eigen::Matrix<double, 30, N> D;
+  Eigen::Matrix<double, 30, 1> lo, up;
+};
+StackedTick stacked(const Tick& t) {
+  StackedTick s;
+  s.A << t.A1, t.A2, t.A3, t.A4a, t.A4b;
+  s.b << t.b1, t.b2, t.b3, t.b4a, t.b4b;
+  s.w.setOnes();
+  s.D << t.D1, t.D2;
+  s.lo << t.lo1, Eigen::Matrix<double, 18, 1>::Constant(-hqp::kInf);
+  s.up << t.up1, t.up2;
+  return s;
+}
+const std::vector<StackedTick>& stackedSeq(const std::vector<Tick>& seq) {
+  static std::vector<StackedTick> warm, cold;
+  auto& out = &seq == &ticks() ? warm : cold;
+  if (out.empty())
+    for (const Tick& t : seq) out.push_back(stacked(t));
+  return out;
+}
+
+class TickPeer {
  public:
-  using Qp = hqp::ActiveSetQp<N, 15, 2, 30>;
-  int solve(const Tick& t, bool warm) {
-    std::vector<Eigen::MatrixXd> A = {t.A1, t.A2, t.A3, Eigen::MatrixXd(15, N)};
-    A[3] << t.A4a, t.A4b;
-    std::vector<Eigen::VectorXd> b = {t.b1, t.b2, t.b3, Eigen::VectorXd(15)};
-    b[3] << t.b4a, t.b4b;
-    Eigen::MatrixXd D(0, N);
-    Eigen::VectorXd lo(0), up(0);
-    Eigen::MatrixXd Nmat = Eigen::MatrixXd::Identity(N, N);
-    Eigen::VectorXd x = Eigen::VectorXd::Zero(N);
-    int failures = 0;
-    for (int p = 0; p < 4; ++p) {
-      if (p < 2) {  // append this level's constraints
-        const Eigen::MatrixXd Dp = p == 0 ? Eigen::MatrixXd(t.D1) : Eigen::MatrixXd(t.D2);
-        const Eigen::VectorXd lp = p == 0 ? Eigen::VectorXd(t.lo1)
-                                          : Eigen::VectorXd::Constant(18, -hqp::kInf);
-        const Eigen::VectorXd upp = p == 0 ? Eigen::VectorXd(t.up1) : Eigen::VectorXd(t.up2);
-        Eigen::MatrixXd D2(D.rows() + Dp.rows(), N);
-        D2 << D, Dp;
-        Eigen::VectorXd lo2(lo.size() + lp.size()), up2(up.size() + upp.size());
-        lo2 << lo, lp;
-        up2 << up, upp;
-        D = D2;
-        lo = lo2;
-        up = up2;
-      }
-      const Eigen::MatrixXd AN = A[p] * Nmat;
-      Qp& qp = qps_[static_cast<std::size_t>(p)];
-      const int m = static_cast<int>(AN.rows()), c = static_cast<int>(D.rows());
-      qp.resize(N, m, 0, c);
-      qp.A() = AN;
-      qp.b() = b[p] - A[p] * x;
-      qp.C() = D * Nmat;
-      const Eigen::VectorXd dx = D * x;
-      qp.lower() = (lo - dx).cwiseMin(0.0).eval();
-      qp.upper() = (up - dx).eval();
-      for (int i = 0; i < c; ++i) {  // higher rows: 0 feasible (as in HqpWbc)
-        if (p > 0 && i < (p == 1 ? 12 : 30)) qp.upper()(i) = std::max(qp.upper()(i), 0.0);
-        if (!(p > 0 && i < (p == 1 ? 12 : 30))) qp.lower()(i) = lo(i) - dx(i);
-      }
-      if (!warm) qp.resetWorkingSet();
-      Qp::VectorX hint = Qp::VectorX::Zero(N);
-      failures += qp.solve(hint, warm) != hqp::QpStatus::Optimal;
-      x += Nmat * qp.x();
-      Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(AN);
-      cod.setThreshold(1e-9);
-      Nmat = Nmat * (Eigen::MatrixXd::Identity(N, N) - cod.pseudoInverse() * AN);
-    }
-    x_ = x;
-    return failures;
+  int solve(const StackedTick& t, bool warm) {
+    return peer_.solve(t.A, t.b, t.w, t.D, t.lo, t.up, {0, 6, 18, 21, 36}, {0, 12, 30, 30, 30}, warm);
   }
-  const Eigen::VectorXd& x() const { return x_; }
+  const Eigen::VectorXd& x() const { return peer_.x(); }
 
  private:
-  std::array<Qp, 4> qps_;
-  Eigen::VectorXd x_;
+  hqp::bench::PeerCascade<N, 4, 15, 30> peer_;
 };
 
 void BM_PeerWarm(benchmark::State& state) {
-  static PeerCascade peer;
-  const auto& seq = ticks();
+  static TickPeer peer;
+  const auto& seq = stackedSeq(ticks());
   std::size_t k = 0;
   long failures = 0;
   for (auto _ : state) {
@@ -348,8 +322,8 @@ void BM_PeerWarm(benchmark::State& state) {
 }
 
 void BM_PeerCold(benchmark::State& state) {
-  static PeerCascade peer;
-  const auto& seq = scenes();
+  static TickPeer peer;
+  const auto& seq = stackedSeq(scenes());
   std::size_t k = 0;
   long failures = 0;
   for (auto _ : state) {
