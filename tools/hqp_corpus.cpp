@@ -412,6 +412,7 @@ int showCommand(const std::string& file, int k) {
   if (k < 0 || k >= static_cast<int>(v.size())) throw std::runtime_error("no instance " + std::to_string(k));
   const Instance& in = v[static_cast<std::size_t>(k)];
   auto wbc = std::make_unique<Wbc>(info.settings);
+  wbc->setKktResiduals(true);  // the certificate says which of two disagreeing solves is optimal
   std::printf("%s instance %d (tick %lld, t = %.3f s)\n", file.c_str(), k, static_cast<long long>(in.tick), in.time);
   std::array<Eigen::Matrix<double, NX, 1>, 2> x;
   for (int warm = 1; warm >= 0; --warm) {
@@ -426,6 +427,9 @@ int showCommand(const std::string& file, int k) {
       std::printf("  level %d: %-16s objective %.12g  stored %-16s iterations %d  active %d  rank %d  null %d  dual %d\n",
                   p + 1, hqp::toString(l.status), f[p], hqp::toString(in.result.levels[p].status), l.iterations,
                   l.num_active, l.rank, l.null_dim, l.dual ? 1 : 0);
+      if (l.kkt.computed)
+        std::printf("           KKT: stationarity %.3g (scale %.3g), primal %.3g, dual %.3g, complementarity %.3g\n",
+                    l.kkt.stationarity, l.kkt.stationarity_scale, l.kkt.primal, l.kkt.dual, l.kkt.complementarity);
     }
   }
   std::printf("|x_warm - x_cold|_inf = %.3g\n", (x[1] - x[0]).lpNorm<Eigen::Infinity>());

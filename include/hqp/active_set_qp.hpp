@@ -1033,8 +1033,11 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
     // Most negative multiplier (μ = λ at upper, −λ at lower); smallest index after
     // repeated degenerate steps (Bland-like anti-cycling). Rows with lower == upper
     // are equalities: never dropped.
+    // Sign threshold relative to the gradient's part in range(Kᵀ), y = −Q₁ᵀ g (multipliers()),
+    // not to max |λ|: on a nearly dependent K the multipliers grow like 1/σ_min(K) (1e17
+    // observed) and a max-|λ| scale let a wrong-signed λ of −505 pass as rounding.
     double gs = 1.0;
-    for (int i = 0; i < k_; ++i) gs = std::max(gs, std::abs(lam_(i)));
+    for (int i = 0; i < k_; ++i) gs = std::max(gs, std::abs(y_(i)));
     const double thr = -settings_.dual_tol * gs;
     int drop = -1;
     double worst = thr;
