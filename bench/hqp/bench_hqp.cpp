@@ -210,8 +210,7 @@ double activeRows(const W& w) {
 
 // Warm: consecutive ticks, each level's working set from the previous tick.
 template <class W>
-void BM_HqpWarm(benchmark::State& state) {
-  static W w;
+void warmTicks(benchmark::State& state, W& w) {
   const auto& seq = ticks();
   std::size_t k = 0;
   long failures = 0;
@@ -224,6 +223,20 @@ void BM_HqpWarm(benchmark::State& state) {
     k = (k + 1) % seq.size();
   }
   reportCounters(state, w, failures, active);
+}
+
+template <class W>
+void BM_HqpWarm(benchmark::State& state) {
+  static W w;
+  warmTicks(state, w);
+}
+
+// The same with the certificate's KKT residuals computed every solve (HqpSettings::kkt_residuals).
+template <class W>
+void BM_HqpWarmKkt(benchmark::State& state) {
+  static W w;
+  w.setKktResiduals(true);
+  warmTicks(state, w);
 }
 
 // Cold: unrelated scenes, working sets forgotten before every solve.
@@ -341,6 +354,7 @@ BENCHMARK_TEMPLATE(BM_HqpWarm, Wbc1)->Name("BM_HqpWarm/levels_1");
 BENCHMARK_TEMPLATE(BM_HqpWarm, Wbc2)->Name("BM_HqpWarm/levels_1-2");
 BENCHMARK_TEMPLATE(BM_HqpWarm, Wbc3)->Name("BM_HqpWarm/levels_1-3");
 BENCHMARK_TEMPLATE(BM_HqpWarm, Wbc4)->Name("BM_HqpWarm/levels_1-4");
+BENCHMARK_TEMPLATE(BM_HqpWarmKkt, Wbc4)->Name("BM_HqpWarm/levels_1-4/kkt_residuals");
 BENCHMARK_TEMPLATE(BM_HqpCold, Wbc1)->Name("BM_HqpCold/levels_1");
 BENCHMARK_TEMPLATE(BM_HqpCold, Wbc2)->Name("BM_HqpCold/levels_1-2");
 BENCHMARK_TEMPLATE(BM_HqpCold, Wbc3)->Name("BM_HqpCold/levels_1-3");
