@@ -101,16 +101,21 @@ TEST(HqpBudget, TinyTimeBudgetKeepsLevelZeroExact) {
   }
 }
 
+// Both hierarchies cold on d, g_full with an iteration budget of 1; returns g_top2's status.
+hqp::QpStatus solveWithIterationBudgetOne(const Data& d) {
+  g_full.resetWarmStart();
+  g_top2.resetWarmStart();
+  g_full.setBudget(0.0, 1);
+  fill(g_full, d);
+  fill(g_top2, d);
+  g_full.solve();
+  return g_top2.solve();
+}
+
 TEST(HqpBudget, IterationBudgetCutsTheLevelThatWouldExceedIt) {
   for (unsigned seed = 1; seed <= 20; ++seed) {
     const Data d = makeData(seed);
-    g_full.resetWarmStart();
-    g_top2.resetWarmStart();
-    g_full.setBudget(0.0, 1);
-    fill(g_full, d);
-    fill(g_top2, d);
-    g_full.solve();
-    ASSERT_EQ(g_top2.solve(), hqp::QpStatus::Optimal) << seed;
+    ASSERT_EQ(solveWithIterationBudgetOne(d), hqp::QpStatus::Optimal) << seed;
     const auto& r = g_full.result();
     // Level 1 starts (nothing spent, no history) and needs ≥ 2 iterations: level 2 is cut.
     ASSERT_EQ(r.levels[0].iterations, 0) << seed;
@@ -197,13 +202,7 @@ TEST(HqpLevelTiming, BudgetsWorkWithTimingOff) {
   g_full.setLevelTiming(false);
   for (unsigned seed = 1; seed <= 20; ++seed) {
     const Data d = makeData(seed);
-    g_full.resetWarmStart();
-    g_top2.resetWarmStart();
-    g_full.setBudget(0.0, 1);
-    fill(g_full, d);
-    fill(g_top2, d);
-    g_full.solve();
-    ASSERT_EQ(g_top2.solve(), hqp::QpStatus::Optimal) << seed;
+    ASSERT_EQ(solveWithIterationBudgetOne(d), hqp::QpStatus::Optimal) << seed;
     const auto& r = g_full.result();
     ASSERT_GE(r.levels[1].iterations, 2) << seed;
     EXPECT_EQ(r.cut_level, 2) << seed;
