@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The sanitizer job of CI (docs/development.md, "Build and CI cost"): the CMake preset `asan`
-# (GCC, -fsanitize=address,undefined at -O1) builds a subset of the test suites (the QP solvers,
+# (clang-14, -fsanitize=address,undefined at -O1) builds a subset of the test suites (the QP solvers,
 # the state estimator) and runs them; the fuzzers cover HqpWbc and the controller tick under
 # ASan+UBSan (docs/development.md).
 # Any ASan/UBSan report fails the test binary. Extra arguments replace the list of test targets.
@@ -9,6 +9,11 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=(test_qp_dual test_qp_random test_state_estimator)
 cd "$root"
+bash "$root/scripts/setup.sh" --fuzz >/dev/null   # clang-14 and its sanitizer runtimes
+cache=build-asan/CMakeCache.txt   # a folder configured by GCC before the preset named clang-14
+if [ -f "$cache" ] && ! grep -q '^CMAKE_CXX_COMPILER:[A-Z]*=.*clang++-14$' "$cache"; then
+  rm -rf build-asan
+fi
 cmake --preset asan >/dev/null
 if [ $# -eq 0 ]; then
   cmake --build build-asan -j"$(nproc)" --target hqp_asan_subset   # the targets in parallel

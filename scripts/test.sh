@@ -10,9 +10,10 @@ start=$(date +%s)
 # Benchmarks are built and run by scripts/bench.sh (-O3 -march=native builds take ~5 of the
 # CI's minutes; docs/development.md "Build and CI cost").
 # The tests are compiled with clang-14 (installed by setup.sh --fuzz): their template-heavy units
-# compile in about half GCC's CPU time (docs/development.md). GCC still builds the sanitizer
-# subset, the user project of Install.UserProject and the benchmarks. A build folder configured
-# with another compiler (e.g. by demo.sh first) is reconfigured; demo.sh keeps what it finds.
+# compile in about half GCC's CPU time (docs/development.md); so does the sanitizer subset
+# (preset asan). GCC still builds the user project of Install.UserProject and the benchmarks.
+# A build folder configured with another compiler (e.g. by demo.sh first) is reconfigured;
+# demo.sh keeps what it finds.
 cc=clang-14 cxx=clang++-14
 cache="$build/CMakeCache.txt"
 if [ -f "$cache" ] && ! grep -q "^CMAKE_CXX_COMPILER:[A-Z]*=.*$cxx\$" "$cache"; then
