@@ -53,6 +53,9 @@ nlohmann::ordered_json runRecord(const ScenarioParams& p, const RunSummary& r) {
   j["min_torso_height_m"] = r.min_torso_height;
   j["com_x_min_mm"] = r.com_x_min * 1e3;
   j["com_x_max_mm"] = r.com_x_max * 1e3;
+  // The CoM's return between pushes (PassRules::com_return); null where it is not measured.
+  if (std::isfinite(r.com_return)) j["com_return_mm"] = r.com_return * 1e3;
+  else j["com_return_mm"] = nullptr;
   j["com_y_min_mm"] = r.com_y_min * 1e3;
   j["com_y_max_mm"] = r.com_y_max * 1e3;
   j["max_foot_pitch_deg"] = r.max_abs_foot_pitch[1] * kDeg;  // the right foot, as in the paper's Fig. 8(a)
@@ -290,6 +293,10 @@ void printRecord(std::FILE* out, const nlohmann::ordered_json& j) {
     std::fprintf(out, "  %-5s sole contact  : max tilt %.2f deg to its support, %.3f s tilted, slide %.1f mm\n",
                  f["foot"].get<std::string>().c_str(), f["max_tilt_deg"].get<double>(), f["tilt_time_s"].get<double>(),
                  f["slide_mm"].get<double>());
+  }
+  if (!j["com_return_mm"].is_null()) {
+    std::fprintf(out, "  CoM return         : %.1f mm, the farthest it rested from where it was before the first push\n",
+                 j["com_return_mm"].get<double>());
   }
   std::fprintf(out, "  pass rules         :");
   for (const auto& x : j["rules"]) {

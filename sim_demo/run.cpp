@@ -142,6 +142,9 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
     r.cop_max[c].setConstant(-std::numeric_limits<double>::infinity());
   }
   const Eigen::Vector3d com0 = sim.centerOfMass();
+  std::size_t next_push = 0;  // PassRules::com_return: the first push not yet reached
+  Eigen::Vector2d com_rest0 = Eigen::Vector2d::Zero();
+  double com_return = 0.0;
   std::array<double, kContacts> foot_pitch0{}, foot_roll0{}, zmp_sq_sum{};
   std::array<long, kContacts> zmp_tracked{};
   for (int c = 0; c < kContacts; ++c) {
@@ -212,6 +215,13 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
       sim.setSupportTarget(support_actuators[i], q, dq);
     }
     Eigen::Vector3d push = Eigen::Vector3d::Zero();
+    if (next_push < o.pushes.size() && sim.time() + 1e-9 >= o.pushes[next_push].time) {
+      // Where the CoM rests just before this push (the pushes are in time order).
+      const Eigen::Vector2d c = sim.centerOfMass().head<2>();
+      if (next_push == 0) com_rest0 = c;
+      else com_return = std::max(com_return, (c - com_rest0).norm());
+      ++next_push;
+    }
     for (const Push& p : o.pushes) {
       if (p.ball) {
         if (std::abs(sim.time() - p.time) < 0.5 * sim.controlDt()) {
@@ -403,6 +413,10 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
   rule("feet_touch_time", r.feet_touch_ticks * sim.controlDt(), o.rules.feet_touch_time, "s");
   rule("non_optimal_ticks", static_cast<double>(r.non_optimal_ticks), static_cast<double>(o.rules.non_optimal_ticks), "");
   rule("safe_mode_ticks", static_cast<double>(r.safe_mode_ticks), static_cast<double>(o.rules.safe_mode_ticks), "");
+  if (o.supports.empty() && next_push > 0 && !r.fell) {
+    r.com_return = std::max(com_return, (sim.centerOfMass().head<2>() - com_rest0).norm());
+    if (std::isfinite(o.rules.com_return)) rule("com_return", r.com_return, o.rules.com_return, "m");
+  }
   r.passed = !r.fell && r.zmp_inside;
   for (const RuleResult& x : r.rules) r.passed = r.passed && x.passed;
   // The real-time factor of the loop itself, without video rendering (which is offline work).

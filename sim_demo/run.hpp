@@ -126,11 +126,14 @@ struct PassRules {
   double feet_touch_time = 0.0;                  // s the two soles may touch each other
   long non_optimal_ticks = 0;                    // ticks with any hierarchy level not Optimal
   long safe_mode_ticks = 0;                      // ticks in the controller's safe mode
+  // m: on still ground, the CoM (horizontal) just before each push after the first and at the
+  // end may be at most this far from where it was just before the first push (infinity: off).
+  double com_return = std::numeric_limits<double>::infinity();
 };
 
 // One rule's outcome in a run.
 struct RuleResult {
-  std::string name;  // foot_tilt_time, sole_slide, feet_touch_time, non_optimal_ticks, safe_mode_ticks
+  std::string name;  // foot_tilt_time, sole_slide, feet_touch_time, non_optimal_ticks, safe_mode_ticks, com_return
   double value = 0, threshold = 0;
   const char* unit = "";
   bool passed = true;
@@ -172,6 +175,9 @@ struct RunSummary {
   double tick_mean_us = 0, tick_max_us = 0, tick_p999_us = 0;  // driver compute time
   long safe_mode_ticks = 0;
   long feet_touch_ticks = 0;       // ticks with the two sole plates in contact with each other
+  // m, PassRules::com_return's metric; NaN without a second push or an end after one, or on
+  // moving supports (where the CoM follows the boards).
+  double com_return = std::numeric_limits<double>::quiet_NaN();
   Eigen::Vector3d ball_impulse = Eigen::Vector3d::Zero();  // N·s the thrown balls lost (delivered)
   // Measured CoP (sole frame, from the noise-free F/T wrench) extremes per foot while loaded (f_z >= 10 N).
   std::array<Eigen::Vector2d, kContacts> cop_min, cop_max;

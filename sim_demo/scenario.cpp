@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -424,6 +425,13 @@ const std::vector<Parameter>& parameters() {
       {"rule_non_optimal_ticks", "pass rule: ticks with a hierarchy level not Optimal that the run may have",
        [](P& p, S k, S v) { p.run.rules.non_optimal_ticks = parseInt(k, v, 0, 100000000); },
        [](const P& p) { return std::to_string(p.run.rules.non_optimal_ticks); }},
+      {"rule_com_return",
+       "pass rule: on still ground, the CoM before each later push and at the end within this of where it "
+       "was before the first push, m (inf: off)",
+       [](P& p, S k, S v) {
+         p.run.rules.com_return = v == "inf" ? std::numeric_limits<double>::infinity() : parseDouble(k, v, 0.0, 1.0);
+       },
+       [](const P& p) { return formatDouble(p.run.rules.com_return); }},
       {"rule_safe_mode_ticks", "pass rule: ticks in the controller's safe mode that the run may have",
        [](P& p, S k, S v) { p.run.rules.safe_mode_ticks = parseInt(k, v, 0, 100000000); },
        [](const P& p) { return std::to_string(p.run.rules.safe_mode_ticks); }},

@@ -292,6 +292,37 @@ TEST(PassRules, ASlidingSoleFailsTheRun) {
   EXPECT_TRUE(rule(lenient, "sole_slide").passed);
 }
 
+// The CoM's return between pushes: measured on still ground from the second rest point on (a
+// push, or the end), off as a rule unless its threshold is set, and not measured on a moving
+// support (the CoM follows the boards there).
+TEST(PassRules, ComReturnComparesTheRestsBetweenPushes) {
+  if (!hqp::sim::balanceControllerAvailable()) GTEST_SKIP() << "built without the balance controller";
+  const std::vector<std::string> two = {"pushes=1.5:10:0,3.5:0.001:0", "duration=4"};
+  auto with = [&](const std::string& extra) {
+    auto v = two;
+    v.push_back(extra);
+    return runPreset("push_x", v);
+  };
+  const auto lenient = with("rule_com_return=0.5");
+  ASSERT_FALSE(lenient.fell);
+  ASSERT_TRUE(std::isfinite(lenient.com_return));
+  // A 10 N·s push moves the CoM 4–6 cm; 2 s later it has come back, but not to the micrometre.
+  EXPECT_GT(lenient.com_return, 1e-5);
+  EXPECT_LT(lenient.com_return, 0.5 * (lenient.com_x_max - lenient.com_x_min));
+  EXPECT_TRUE(rule(lenient, "com_return").passed);
+  EXPECT_EQ(rule(lenient, "com_return").value, lenient.com_return);
+  const auto strict = with("rule_com_return=0.00001");
+  EXPECT_EQ(strict.com_return, lenient.com_return);  // the same deterministic run
+  EXPECT_FALSE(rule(strict, "com_return").passed);
+  EXPECT_FALSE(strict.passed);
+  const auto plain = runPreset("push_x", two);  // the preset: measured, not a rule
+  EXPECT_EQ(plain.com_return, lenient.com_return);
+  EXPECT_THROW(rule(plain, "com_return"), std::runtime_error);
+  const auto board = runPreset("seesaw_x", {"pushes=0.5:1:0", "duration=1", "rule_com_return=0.00001"});
+  EXPECT_TRUE(std::isnan(board.com_return));
+  EXPECT_THROW(rule(board, "com_return"), std::runtime_error);
+}
+
 // A rigid robot (joint PD) with 30 kg 0.4 m in front of its torso tips over its toes: the feet
 // tilt on the floor. The metric is the angle between the sole's and the support's (world) z
 // axes; on the floor it is at least the sole's world pitch, which MuJoCo's frame gives directly.
