@@ -142,7 +142,10 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
     r.cop_max[c].setConstant(-std::numeric_limits<double>::infinity());
   }
   const Eigen::Vector3d com0 = sim.centerOfMass();
-  std::size_t next_push = 0;  // PassRules::com_return: the first push not yet reached
+  std::vector<double> push_times;  // PassRules::com_return: the pushes in time order
+  for (const Push& p : o.pushes) push_times.push_back(p.time);
+  std::sort(push_times.begin(), push_times.end());
+  std::size_t next_push = 0;  // the first of them not yet reached
   Eigen::Vector2d com_rest0 = Eigen::Vector2d::Zero();
   double com_return = 0.0;
   std::array<double, kContacts> foot_pitch0{}, foot_roll0{}, zmp_sq_sum{};
@@ -215,8 +218,8 @@ RunSummary runScenario(Simulation& sim, Driver& driver, const RunOptions& o) {
       sim.setSupportTarget(support_actuators[i], q, dq);
     }
     Eigen::Vector3d push = Eigen::Vector3d::Zero();
-    if (next_push < o.pushes.size() && sim.time() + 1e-9 >= o.pushes[next_push].time) {
-      // Where the CoM rests just before this push (the pushes are in time order).
+    while (next_push < push_times.size() && sim.time() + 1e-9 >= push_times[next_push]) {
+      // Where the CoM rests just before this push.
       const Eigen::Vector2d c = sim.centerOfMass().head<2>();
       if (next_push == 0) com_rest0 = c;
       else com_return = std::max(com_return, (c - com_rest0).norm());

@@ -317,6 +317,8 @@ TEST(PassRules, ComReturnComparesTheRestsBetweenPushes) {
   EXPECT_FALSE(strict.passed);
   const auto plain = runPreset("push_x", two);  // the preset: measured, not a rule
   EXPECT_EQ(plain.com_return, lenient.com_return);
+  // The pushes listed out of time order: the same rests.
+  EXPECT_EQ(runPreset("push_x", {"pushes=3.5:0.001:0,1.5:10:0", "duration=4"}).com_return, lenient.com_return);
   EXPECT_THROW(rule(plain, "com_return"), std::runtime_error);
   const auto board = runPreset("seesaw_x", {"pushes=0.5:1:0", "duration=1", "rule_com_return=0.00001"});
   EXPECT_TRUE(std::isnan(board.com_return));
