@@ -175,8 +175,8 @@ struct RunSummary {
   double tick_mean_us = 0, tick_max_us = 0, tick_p999_us = 0;  // driver compute time
   long safe_mode_ticks = 0;
   long feet_touch_ticks = 0;       // ticks with the two sole plates in contact with each other
-  // m, PassRules::com_return's metric; NaN without a second push or an end after one, or on
-  // moving supports (where the CoM follows the boards).
+  // m, PassRules::com_return's metric; NaN if no push was reached, after a fall, or on moving
+  // supports (where the CoM follows the boards).
   double com_return = std::numeric_limits<double>::quiet_NaN();
   Eigen::Vector3d ball_impulse = Eigen::Vector3d::Zero();  // N·s the thrown balls lost (delivered)
   // Measured CoP (sole frame, from the noise-free F/T wrench) extremes per foot while loaded (f_z >= 10 N).
