@@ -26,6 +26,9 @@ struct BalanceParameters {
   // loop millimetres off its reference; the integral takes it back (docs/tasks.md).
   double com_ki = 0.0;               // 1/s³
   double com_integral_limit = 0.02;  // m·s
+  // Reset an axis's integral to 0 when its error has the opposite sign (Clegg 1958): the
+  // integral stored during a push then does not carry the CoM past its reference on the way back.
+  bool com_integral_reset = false;
   double dt = 0.001;                 // s, the control period (the controller sets it from its own)
   // Capture-point gain schedule of the horizontal CoM rows, beyond the paper: the gains blend from
   // `com` to `com_high` as |e + ė/ω| grows from com_dcm_low to com_dcm_high (m); off while

@@ -218,9 +218,10 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
     b.com = r.gains(n, p, "com");
     b.com_vertical = r.gains(n, p, "com_vertical");
     if (n["com_integral"]) {  // optional, beyond the paper
-      const YAML::Node g = r.map(n, p, "com_integral", {"ki", "limit"});
+      const YAML::Node g = r.map(n, p, "com_integral", {"ki", "limit", "reset_on_crossing"});
       b.com_ki = r.atLeast(g, p + ".com_integral", "ki", 0.0, false);
       b.com_integral_limit = r.atLeast(g, p + ".com_integral", "limit", 0.0, false);
+      if (g["reset_on_crossing"]) b.com_integral_reset = r.boolean(g, p + ".com_integral", "reset_on_crossing");
     }
     if (n["com_schedule"]) {  // optional, beyond the paper
       const YAML::Node g = r.map(n, p, "com_schedule", {"dcm_low", "dcm_high", "kp", "kd"});

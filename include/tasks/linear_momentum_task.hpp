@@ -3,7 +3,9 @@
 //   Ṗ = A_G,lin q̈ + (Ȧ_G v)_lin = m a,   a = a_ff + kp e + kd ė,
 //   e = r_CoM,ref − r_CoM,  ė = v_CoM,ref − v_CoM,
 // Two extensions beyond the paper on the horizontal rows, both off by default (docs/tasks.md):
-//   ki ∫e dt, the integral clamped per axis;
+//   ki ∫e dt, the integral clamped per axis and, optionally, reset to 0 on an axis whose error
+//   has the opposite sign of its integral (a Clegg integrator): what it stored while the push
+//   carried the CoM away then cannot carry the CoM past its reference on the way back;
 //   a capture-point gain schedule: per axis the gains blend from (kp, kd) to (kp_high, kd_high)
 //   as the capture-point error |e + ė/ω| (ω = √(g / CoM height above the feet)) grows from
 //   dcm_low to dcm_high, so soft gains ride out what the ankles can absorb and stiff ones act
@@ -53,6 +55,11 @@ class LinearMomentumTask : public hqp::Task<3, Layout::nx> {
       }
     }
     if (ki_ > 0.0) {
+      if (reset_on_crossing_) {
+        for (int i = 0; i < 2; ++i) {
+          if (error_[i] * integral_[i] < 0.0) integral_[i] = 0.0;
+        }
+      }
       integral_ = (integral_ + dt_ * error_.head<2>()).cwiseMax(-integral_limit_).cwiseMin(integral_limit_);
       a.head<2>() += ki_ * integral_;
     }
@@ -67,6 +74,7 @@ class LinearMomentumTask : public hqp::Task<3, Layout::nx> {
     vertical = p.com_vertical;
     ki_ = p.com_ki;
     integral_limit_ = p.com_integral_limit;
+    reset_on_crossing_ = p.com_integral_reset;
     dt_ = p.dt;
     high_ = p.com_high;
     dcm_low_ = p.com_dcm_low;
@@ -77,6 +85,9 @@ class LinearMomentumTask : public hqp::Task<3, Layout::nx> {
   // The integral back to zero (Controller::reset()).
   void resetState() noexcept { integral_.setZero(); }
 
+  // ∫e dt of the horizontal rows (m·s), as the last update left it.
+  const Eigen::Vector2d& integral() const { return integral_; }
+
   // r_CoM,ref − r_CoM at the last update (m).
   const Eigen::Vector3d& error() const { return error_; }
 
@@ -84,6 +95,7 @@ class LinearMomentumTask : public hqp::Task<3, Layout::nx> {
   Eigen::Vector3d error_ = Eigen::Vector3d::Zero();
   Eigen::Vector2d integral_ = Eigen::Vector2d::Zero();  // m·s, horizontal
   double ki_ = 0.0, integral_limit_ = 0.0, dt_ = 0.001;
+  bool reset_on_crossing_ = false;
   PdGains high_{};
   double dcm_low_ = 0.0, dcm_high_ = 0.0;  // m; dcm_high <= dcm_low: no schedule
 };

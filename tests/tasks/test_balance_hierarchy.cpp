@@ -477,6 +477,45 @@ TEST_F(BalanceHierarchy, ComScheduleAndIntegral) {
   EXPECT_LT((plain.b.head<2>() - dyn.mass() * params.com.kp * e).norm(), 1e-9);
 }
 
+// The integral's reset on a sign change (a Clegg integrator), per axis: the reference steps to
+// the other side of the CoM on x only. Expected: x's integral restarts from 0 at the step
+// (then grows with the new error), y's keeps growing; without the reset x's integral first
+// unwinds through the old sum. Closed forms from the error sequence, at rest (ė = 0).
+TEST_F(BalanceHierarchy, ComIntegralResetOnSignChange) {
+  hqp::tasks::BalanceParameters<Robot::nj> p = params;
+  p.com_ki = 3.0;
+  p.com_integral_limit = 1.0;  // no clamp in this test
+  p.dt = 0.001;
+  p.com_integral_reset = true;
+  hqp::tasks::BalanceParameters<Robot::nj> q_off = p;
+  q_off.com_integral_reset = false;
+  Refs ahead = refs, behind = refs;
+  ahead.com += Eigen::Vector3d(0.02, 0.01, 0.0);
+  behind.com += Eigen::Vector3d(-0.03, 0.01, 0.0);
+  const Eigen::Vector2d e1 = (ahead.com - dyn.com()).head<2>(), e2 = (behind.com - dyn.com()).head<2>();
+  ASSERT_GT(e1.x(), 0.0);
+  ASSERT_LT(e2.x(), 0.0);
+  ASSERT_GT(e1.y() * e2.y(), 0.0);
+  hqp::tasks::LinearMomentumTask<Layout> on, off;
+  on.configure(p);
+  off.configure(q_off);
+  for (int k = 0; k < 10; ++k) {
+    on.update(dyn, ahead);
+    off.update(dyn, ahead);
+  }
+  EXPECT_LT((on.integral() - 10 * 0.001 * e1).norm(), 1e-12);
+  EXPECT_LT((off.integral() - on.integral()).norm(), 1e-15);
+  for (int k = 1; k <= 4; ++k) {
+    on.update(dyn, behind);
+    off.update(dyn, behind);
+    EXPECT_NEAR(on.integral().x(), k * 0.001 * e2.x(), 1e-12) << "tick " << k;
+    EXPECT_NEAR(off.integral().x(), 10 * 0.001 * e1.x() + k * 0.001 * e2.x(), 1e-12) << "tick " << k;
+    EXPECT_NEAR(on.integral().y(), 10 * 0.001 * e1.y() + k * 0.001 * e2.y(), 1e-12) << "tick " << k;
+    // The task's right-hand side carries the reset integral: b = m (kp e + ki ∫e dt) on x.
+    EXPECT_NEAR(on.b.x(), dyn.mass() * (p.com.kp * e2.x() + 3.0 * on.integral().x()), 1e-9);
+  }
+}
+
 // A robot in motion (every velocity non-zero) with velocity references equal to the current
 // velocities: the feet (level 2) and the CoM (level 3) are asked for zero classical
 // acceleration, which holds only if the tasks subtract J̇v and Ȧ_G v with the right sign.

@@ -100,6 +100,7 @@ TEST(ControllerConfig, ShippedFileLoads) {
   EXPECT_EQ(c.balance.com_dcm_high, 0.10);
   EXPECT_EQ(c.balance.com_ki, 4.0);
   EXPECT_EQ(c.balance.com_integral_limit, 0.03);
+  EXPECT_TRUE(c.balance.com_integral_reset);
   EXPECT_TRUE(c.planner.hold_tipping_axis);
   EXPECT_EQ(c.balance.com_vertical.kp, 9.0);
   EXPECT_EQ(c.balance.com_vertical.kd, 6.0);
@@ -146,7 +147,7 @@ TEST(ControllerConfig, MissingKeyNamesKeyAndFile) {
   expectRejected("  mu: 0.6", "  # mu removed", "balance.mu");
   expectRejected("  max_tilt: 0.8", "  # gone", "safe_mode.max_tilt");
   expectRejected("com:          {kp: 4, kd: 3}", "com:          {kp: 4}", "balance.com.kd");
-  expectRejected("com_integral: {ki: 4, limit: 0.03}", "com_integral: {ki: 4}", "balance.com_integral.limit");
+  expectRejected("com_integral: {ki: 4, limit: 0.03,", "com_integral: {ki: 4,", "balance.com_integral.limit");
   expectRejected("  com_vertical: {kp: 9, kd: 6}", "  # com_vertical gone", "balance.com_vertical");
   expectRejected("  torsion_radius: 0.05", "  # torsion_radius gone", "balance.torsion_radius");
   expectRejected("    r_knee:         250", "    # r_knee", "balance.torque_limit.r_knee");
@@ -167,6 +168,7 @@ TEST(ControllerConfig, UnknownKeyIsRejected) {
 
 TEST(ControllerConfig, NegativeOrInvalidValuesAreRejected) {
   expectRejected("com:          {kp: 4, kd: 3}", "com:          {kp: -4, kd: 3}", "balance.com.kp");
+  expectRejected("reset_on_crossing: true", "reset_on_crossing: 1.5", "balance.com_integral.reset_on_crossing");
   expectRejected("dcm_low: 0.07, dcm_high: 0.10", "dcm_low: 0.10, dcm_high: 0.07", "balance.com_schedule.dcm_high");
   expectRejected("com_integral: {ki: 4,", "com_integral: {ki: -4,", "balance.com_integral.ki");
   expectRejected("  hold_tipping_axis: true", "  hold_tipping_axis: 2x", "planner.hold_tipping_axis");
@@ -236,6 +238,10 @@ TEST(ControllerConfig, MovingSupportOptionsDefaultToThePaperRule) {
   ASSERT_TRUE(i.found());
   EXPECT_FALSE(hqp::tasks::loadControllerConfig<Robot>(h.path()).balance.com_dcm_high > 0.0);
   EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(i.path()).balance.com_ki, 0.0);
+  EditedConfig j(", reset_on_crossing: true}", "}");  // the reset is optional too: off
+  ASSERT_TRUE(j.found());
+  EXPECT_FALSE(hqp::tasks::loadControllerConfig<Robot>(j.path()).balance.com_integral_reset);
+  EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(j.path()).balance.com_ki, 4.0);
 }
 
 TEST(ControllerConfig, OtherSolverAndInfiniteLeakLoad) {
