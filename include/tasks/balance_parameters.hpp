@@ -3,6 +3,8 @@
 // limits, level-4 weights). Plain data; robots/walker3/controller.yaml overrides them.
 // Defaults are chosen for Walker3 (43 kg, 1 kHz); the reasons are in docs/tasks.md.
 
+#include <limits>
+
 #include <Eigen/Core>
 
 #include "hqp/hqp_types.hpp"
@@ -36,6 +38,9 @@ struct BalanceParameters {
   PdGains com_high{9.0, 6.0};
   double com_dcm_low = 0.0, com_dcm_high = 0.0;
   PdGains torso{200.0, 28.28};
+  // Largest torso error the proportional term acts on (rad), beyond the paper: a saturated PD
+  // brings a torso the hip strategy pitched far back at a bounded rate (∞ = the paper's PD).
+  double torso_error_limit = std::numeric_limits<double>::infinity();
   double mu = 0.6;        // friction coefficient (rubber sole on floor ~0.8–1; kept conservative)
   double fz_min = 10.0;   // N, unilateral margin: ~2 % of the weight keeps a lightly loaded foot down
   // CoP rectangle in the sole frame (m): the 0.22 × 0.10 sole box is centred on the sole frame

@@ -211,7 +211,7 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
     const YAML::Node n = r.map(root, "", p,
                                {"foot_linear", "foot_angular", "com", "com_vertical", "torso", "mu",
                                 "fz_min", "cop_region", "torque_limit", "torso_weight", "force_weight",
-                                "torsion_radius", "com_integral", "com_schedule"});
+                                "torsion_radius", "com_integral", "com_schedule", "torso_error_limit"});
     BalanceParameters<nj>& b = c.balance;
     b.foot_linear = r.gains(n, p, "foot_linear");
     b.foot_angular = r.gains(n, p, "foot_angular");
@@ -234,6 +234,7 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
       }
     }
     b.torso = r.gains(n, p, "torso");
+    if (n["torso_error_limit"]) b.torso_error_limit = r.atLeast(n, p, "torso_error_limit", 0.0, true, true);  // beyond the paper; .inf = off
     b.mu = r.atLeast(n, p, "mu", 0.0, true);
     b.fz_min = r.atLeast(n, p, "fz_min", 0.0, false);
     r.rectangle(n, p, "cop_region", b.sole_x_min, b.sole_x_max, b.sole_y_min, b.sole_y_max);

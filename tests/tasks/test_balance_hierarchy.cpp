@@ -433,6 +433,18 @@ TEST_F(BalanceHierarchy, OperationalTasksPullTowardsTheReference) {
             1e-9);
   EXPECT_NE(params.com.kp, params.com_vertical.kp);  // else the line above cannot tell them apart
   EXPECT_LT((torso.b - params.torso.kp * Eigen::Vector3d(-0.1, 0, 0)).norm(), 1e-9);
+  // The saturated torso PD: the proportional term acts on the error shortened to its limit
+  // (0.04 of the 0.1 rad), a limit above the error changes nothing.
+  auto sat = params;
+  sat.torso_error_limit = 0.04;
+  torso.configure(sat);
+  torso.update(dyn, r);
+  EXPECT_LT((torso.b - params.torso.kp * Eigen::Vector3d(-0.04, 0, 0)).norm(), 1e-9);
+  EXPECT_LT((torso.error() - Eigen::Vector3d(-0.1, 0, 0)).norm(), 1e-9);  // reported unsaturated
+  sat.torso_error_limit = 0.2;
+  torso.configure(sat);
+  torso.update(dyn, r);
+  EXPECT_LT((torso.b - params.torso.kp * Eigen::Vector3d(-0.1, 0, 0)).norm(), 1e-9);
   // Rows: the feet's Jacobians, A_G's linear rows (m × CoM Jacobian), the torso's angular rows.
   EXPECT_TRUE((feet.A.block<6, Robot::nv>(6, 0).isApprox(dyn.J(1), 1e-15)));
   EXPECT_TRUE(com.A.leftCols<Robot::nv>().isApprox(kMass * dyn.Jcom(), 1e-12));

@@ -101,6 +101,7 @@ TEST(ControllerConfig, ShippedFileLoads) {
   EXPECT_EQ(c.balance.com_ki, 4.0);
   EXPECT_EQ(c.balance.com_integral_limit, 0.03);
   EXPECT_TRUE(c.balance.com_integral_reset);
+  EXPECT_EQ(c.balance.torso_error_limit, 0.2);
   EXPECT_TRUE(c.planner.hold_tipping_axis);
   EXPECT_EQ(c.balance.com_vertical.kp, 9.0);
   EXPECT_EQ(c.balance.com_vertical.kd, 6.0);
@@ -169,6 +170,7 @@ TEST(ControllerConfig, UnknownKeyIsRejected) {
 TEST(ControllerConfig, NegativeOrInvalidValuesAreRejected) {
   expectRejected("com:          {kp: 4, kd: 3}", "com:          {kp: -4, kd: 3}", "balance.com.kp");
   expectRejected("reset_on_crossing: true", "reset_on_crossing: 1.5", "balance.com_integral.reset_on_crossing");
+  expectRejected("  torso_error_limit: 0.2", "  torso_error_limit: 0", "balance.torso_error_limit");
   expectRejected("dcm_low: 0.07, dcm_high: 0.10", "dcm_low: 0.10, dcm_high: 0.07", "balance.com_schedule.dcm_high");
   expectRejected("com_integral: {ki: 4,", "com_integral: {ki: -4,", "balance.com_integral.ki");
   expectRejected("  hold_tipping_axis: true", "  hold_tipping_axis: 2x", "planner.hold_tipping_axis");
@@ -242,6 +244,10 @@ TEST(ControllerConfig, MovingSupportOptionsDefaultToThePaperRule) {
   ASSERT_TRUE(j.found());
   EXPECT_FALSE(hqp::tasks::loadControllerConfig<Robot>(j.path()).balance.com_integral_reset);
   EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(j.path()).balance.com_ki, 4.0);
+  EditedConfig k("  torso_error_limit: 0.2", "  # (removed)");  // the saturated torso PD: off
+  ASSERT_TRUE(k.found());
+  EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(k.path()).balance.torso_error_limit,
+            std::numeric_limits<double>::infinity());
 }
 
 TEST(ControllerConfig, OtherSolverAndInfiniteLeakLoad) {
