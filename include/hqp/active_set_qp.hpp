@@ -174,8 +174,10 @@ class ActiveSetQp {
   bool prepare();                      // scaled copies
   void startPhase(bool phase1);        // K = E rows only, objective of the phase
   bool addEqualities();                // returns false if E x = e is inconsistent
-  bool addRow(int j, bool upper);      // adds C row j (side) to K; false if dependent
-  bool addRowVector(double rhs);       // adds a_ (length nv_) to K
+  // Adds C row j (side) to K; false if dependent: its part in null(K) relative to its norm is
+  // ≤ rank_tol, or ≤ zmin with the row nearly dependent (iterate(), harmlessCut()).
+  bool addRow(int j, bool upper, double zmin = 0.0);
+  bool addRowVector(double rhs, double zmin = 0.0);  // adds a_ (length nv_) to K
   void removeRow(int pos);             // removes K row pos (pos ≥ neq_)
   void addWarmRows(int nw_prev);       // re-adds ws_prev_* (all at once while Q is implicit)
   // Adds cnt rows (entry c of row l: row(l, c); the phase-1 t entry is 0) to K while Q is
@@ -186,6 +188,11 @@ class ActiveSetQp {
   bool warmUsable(int j, bool up) const {
     return j >= 0 && j < mi_ && !in_ws_(j) && std::abs(up ? us_(j) : ls_(j)) < kInf;
   }
+  // Rank decision for a blocking row of phase 2 (docs/active-set-qp.md, "Nearly dependent
+  // rows"): the largest part ζ in null(K) for which skipping the row is harmless, and whether
+  // the row (w_ = Qᵀa_ set) is nearly dependent on K.
+  double harmlessCut(int j, bool upper, double alpha) const;
+  bool nearlyDependent(double zeta, double anorm);
   bool subproblem();                   // xs_ = optimum on the working set
   bool phase1Certified();              // phase 1's multipliers prove infeasibility (Farkas)
   bool equalitiesCertified();          // a dependent equality contradicts the others
@@ -387,7 +394,7 @@ void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::minNormPoint(VecN& out) {
 }
 
 template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
-bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addRowVector(double rhs) {
+bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addRowVector(double rhs, double zmin) {
   if (k_ >= nv_) return false;
   // w = Qᵀ a; the row is independent of K iff w(k:) = Zᵀ a ≠ 0.
   const int nz = nv_ - k_;
@@ -401,6 +408,8 @@ bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addRowVector(double rhs) {
   const double wn2 = w_.segment(k_, nz).squaredNorm();
   const double tol = settings_.rank_tol;
   if (!(wn2 > tol * tol * an2) || an2 == 0.0) return false;
+  if (wn2 <= zmin * zmin * an2 && nearlyDependent(std::sqrt(wn2 / an2), std::sqrt(an2)))
+    return false;
   if (trap_) {
     addRowStructured(rhs);
     return true;
@@ -650,10 +659,52 @@ void ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::removeRow(int pos) {
 }
 
 template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
-bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addRow(int j, bool upper) {
+double ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::harmlessCut(int j, bool upper,
+                                                              double alpha) const {
+  // Row j (unit norm) blocks the step xc + α d. Left out of K, it moves by at most ζ (1 − α) ‖d‖
+  // over the rest of the step (d ∈ null(K), ζ = ‖Zᵀĉ_j‖), so for ζ up to the returned cut it
+  // stays within its feasibility tolerance (the one feasibleAt() accepts): skipping it changes
+  // x by no more than the solver accepts anyway. 0: no room left.
+  const double bound = upper ? us_(j) : ls_(j);
+  const double viol = upper ? cx_(j) - bound : bound - cx_(j);  // > 0: already past it
+  const double room =
+      settings_.feasibility_tol * (1.0 + std::abs(bound)) - (viol > 0.0 ? viol : 0.0);
+  const double reach = (1.0 - alpha) * d_.head(nv_).norm();
+  if (!(room > 0.0)) return 0.0;
+  return reach > room ? room / reach : 1.0;  // 1: every ζ (≤ 1 for a unit row)
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::nearlyDependent(double zeta, double anorm) {
+  // In exact arithmetic a blocking row is never dependent on K: d ∈ null(K) and ĉ d ≠ 0
+  // (Nocedal & Wright, Numerical Optimization, 2nd ed., Sec. 16.5). One nearly dependent on K
+  // blocks through rounding, or because the vertex it forms with K is ill-posed; added, it
+  // makes K' = [K; a] nearly singular and the multipliers grow like 1/σ_min(K') (~1e16 seen on
+  // the corpus), so their signs, hence the drops and the optimality test, become noise.
+  // Measure: a = Kᵀβ + ζ‖a‖ z with Rβ = w(0:k) (Kᵀ = Q₁R), so K' becomes exactly singular
+  // under a perturbation of its rows of size δ = ζ / ‖(β/‖a‖, 1)‖ ≥ σ_min(K'). Unlike ζ, δ also
+  // catches a row moderately close to a K that is itself nearly dependent (ζ ~1e-7 then ~1e-9
+  // gave δ ~1e-16). Nearly dependent: δ ≤ √ε, more than half the multipliers' digits lost.
+  // The caller skips such a row only where that is harmless (harmlessCut()), as an exactly
+  // dependent one is: treated as held by K, like Goldfarb & Idnani's constraint whose normal
+  // is in the span of the active ones. Refusing it where it is not harmless was measured to
+  // break feasibility of other QPs (docs/benchmarks.md, "Exactness").
+  constexpr double kSqrtEps = 1.4901161193847656e-08;
+  if (zeta <= kSqrtEps) return true;  // δ ≤ ζ
+  for (int i = k_ - 1; i >= 0; --i) {  // β = R⁻¹ w(0:k) into p_ (scratch until subproblem())
+    double t = w_(i);
+    for (int l = i + 1; l < k_; ++l) t -= R_(i, l) * p_(l);
+    p_(i) = t / R_(i, i);
+  }
+  const double c = std::sqrt(1.0 + p_.head(k_).squaredNorm() / (anorm * anorm));
+  return !(zeta > kSqrtEps * c);  // δ ≤ √ε, or NaN
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::addRow(int j, bool upper, double zmin) {
   for (int i = 0; i < n_; ++i) a_(i) = Cs_(j, i);
   if (nv_ > n_) a_(n_) = upper ? -1.0 : 1.0;
-  if (!addRowVector(upper ? us_(j) : ls_(j))) return false;
+  if (!addRowVector(upper ? us_(j) : ls_(j), zmin)) return false;
   ws_row_(nw_) = j;
   ws_upper_(nw_) = upper ? 1 : 0;
   in_ws_(j) = 1;
@@ -1024,7 +1075,8 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
       if (!trap_ && ++changes_ >= kEstablishAfter) establishStructure();
       if (!phase1 && block == just_dropped && alpha * dn <= 1e-14 * (1.0 + xn)) pin_(block) = 1;
       just_dropped = -1;
-      if (addRow(block, block_upper)) ++kver;
+      if (addRow(block, block_upper, phase1 ? 0.0 : harmlessCut(block, block_upper, alpha)))
+        ++kver;
       else skip_(block) = kver;
       continue;
     }
