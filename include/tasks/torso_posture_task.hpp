@@ -2,10 +2,9 @@
 // Level 4 task, eq. 2 on the angular rows of the torso frame (task frame NC):
 //   J_ω q̈ = α_ff + kp sat(e) + kd (ω_ref − ω) − (J̇v)_ω,   e = log(R_ref Rᵀ) (world rotation vector),
 // sat(e) = e scaled to |e| ≤ error_limit (beyond the paper; ∞ = the paper's PD). After the hip
-// strategy has pitched the torso 30–45°, the full kp e asks ~100 rad/s² to bring it back, and the
+// strategy has pitched the torso 30–45°, the full kp e asks 100–150 rad/s² to bring it back, and the
 // reaction of that return throws the CoM the other way (docs/tasks.md).
 
-#include <cmath>
 #include <limits>
 
 #include <Eigen/Core>
