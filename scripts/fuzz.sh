@@ -20,11 +20,8 @@ fuzzers=("$@")
 work="${HQP_FUZZ_DIR:-$build/run}"
 
 bash "$root/scripts/setup.sh" --fuzz
-# -O1: the instrumented units compile in 320 instead of 424 CPU seconds at -O3 (the CI run of
-# fixed input counts takes 70 instead of 47 s; docs/development.md).
-cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O1 -DNDEBUG" \
-      -DCMAKE_CXX_COMPILER=clang++-14 -DHQP_BUILD_FUZZERS=ON -DHQP_BUILD_TESTS=OFF \
-      -DHQP_BUILD_BENCHMARKS=OFF -DHQP_BUILD_SIM_DEMO=OFF >/dev/null
+# The preset `fuzz` (CMakePresets.json: clang-14, -O1, fuzzers only) into $build.
+cmake -S "$root" --preset fuzz -B "$build" >/dev/null
 if [ $# -eq 0 ]; then
   cmake --build "$build" -j"$(nproc)" --target fuzzers   # all of them, in parallel
 else
