@@ -72,6 +72,7 @@ class BalanceDriver final : public Driver {
     h += ",com_err_x,com_err_y,com_err_z,torso_err_x,torso_err_y,torso_err_z,current_saturated";
     // State estimate (world axes): base velocity, per foot trust, moving flag, support velocity.
     h += ",est_base_vx,est_base_vy,est_base_vz,est_accel_bias_x,est_accel_bias_y,est_accel_bias_z";
+    h += ",est_L_x,est_L_y,est_L_z";  // centroidal angular momentum of the estimate (N·m·s, world)
     for (const char* f : {"l", "r"}) {
       const std::string p = std::string(",") + f;
       h += p + "_trust" + p + "_moving" + p + "_support_vx" + p + "_support_vy" + p + "_support_vz";
@@ -129,6 +130,8 @@ class BalanceDriver final : public Driver {
         Eigen::Quaterniond(q[3], q[4], q[5], q[6]) * Eigen::Vector3d(est.v().template head<3>());
     const Eigen::Vector3d ab = est.accelerometerBias();
     std::fprintf(f, ",%.5f,%.5f,%.5f,%.5f,%.5f,%.5f", vb.x(), vb.y(), vb.z(), ab.x(), ab.y(), ab.z());
+    const Eigen::Vector3d L = controller_->dynamics().hg().template tail<3>();
+    std::fprintf(f, ",%.4f,%.4f,%.4f", L.x(), L.y(), L.z());
     for (int c = 0; c < kContacts; ++c) {
       const Eigen::Vector3d& vs = est.supportVelocity(c);
       std::fprintf(f, ",%.3f,%d,%.5f,%.5f,%.5f", est.footTrust(c), est.footMoving(c) ? 1 : 0, vs.x(), vs.y(), vs.z());

@@ -25,7 +25,7 @@ inline Vector6 shiftForceTo(const Vector6& F, const Eigen::Vector3d& c) noexcept
   return r;
 }
 
-// d.com, d.Ag, d.Jcom, d.vcom from the composite pass (kComposite).
+// d.com, d.Ag, d.Jcom, d.vcom, d.hg from the composite pass (kComposite).
 template <class Robot>
 inline void centroidalFromComposite(Data<Robot>& d,
                                     const typename Data<Robot>::VectorV& v) noexcept {
@@ -37,6 +37,7 @@ inline void centroidalFromComposite(Data<Robot>& d,
   }
   d.Jcom = d.Ag.template topRows<3>() / d.Itot.m;
   d.vcom.noalias() = d.Jcom * v;
+  d.hg.noalias() = d.Ag * v;
 }
 
 // d.dAg_v from the RNEA total force (kTau after a q̈ = 0 forward pass with forces).
@@ -58,7 +59,7 @@ void centerOfMass(Data<Robot>& d, const typename Data<Robot>::VectorQ& q,
   detail::centroidalFromComposite(d, v);
 }
 
-// d.Ag (6 x nv) and d.dAg_v (6): h_G = A_G v = [P; L_G], ḣ_G = A_G q̈ + Ȧ_G v.
+// d.Ag (6 x nv), d.hg = A_G v = [P; L_G] and d.dAg_v (6): ḣ_G = A_G q̈ + Ȧ_G v.
 // Also fills d.com, d.vcom, d.Jcom, d.h and the forward kinematics.
 template <class Robot>
 void centroidalMomentum(Data<Robot>& d, const typename Data<Robot>::VectorQ& q,

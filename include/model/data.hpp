@@ -113,6 +113,7 @@ struct Data {
   Matrix3V Jcom;            // CoM Jacobian (3 x nv)
   Jacobian Ag;              // centroidal momentum matrix (6 x nv): [P; L_G] = Ag v
   Vector6 dAg_v;            // Ȧg v (6), eq. 2 for the momentum task
+  Vector6 hg;               // centroidal momentum [P; L_G] = Ag v (6)
 
   Data() noexcept {
     for (int i = 0; i < nb; ++i) {

@@ -74,6 +74,7 @@ class RobotDynamics {
   const Eigen::Matrix<double, 3, Robot::nv>& Jcom() const noexcept { return d_.Jcom; }
   const Eigen::Matrix<double, 6, Robot::nv>& Ag() const noexcept { return d_.Ag; }
   const Vector6& dAg_v() const noexcept { return d_.dAg_v; }
+  const Vector6& hg() const noexcept { return d_.hg; }  // [P; L_G] = A_G v
   double mass() const noexcept { return d_.mass; }
   const Data<Robot>& data() const noexcept { return d_; }
 

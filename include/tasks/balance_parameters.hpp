@@ -37,6 +37,11 @@ struct BalanceParameters {
   // com_dcm_high <= com_dcm_low.
   PdGains com_high{9.0, 6.0};
   double com_dcm_low = 0.0, com_dcm_high = 0.0;
+  // Hip-strategy budget of the horizontal CoM rows, beyond the paper (linear_momentum_task.hpp):
+  // L̇ within [−K (θ + θ_max) − D L, K (θ_max − θ) − D L], θ the torso's tilt; θ_max ∞ = off.
+  double hip_max_tilt = std::numeric_limits<double>::infinity();  // rad, θ_max
+  double hip_stiffness = 0.0;                                      // N·m/rad, K
+  double hip_damping = 0.0;                                        // 1/s, D
   PdGains torso{200.0, 28.28};
   // Largest torso error the proportional term acts on (rad), beyond the paper: a saturated PD
   // brings a torso the hip strategy pitched far back at a bounded rate (∞ = the paper's PD).

@@ -211,7 +211,8 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
     const YAML::Node n = r.map(root, "", p,
                                {"foot_linear", "foot_angular", "com", "com_vertical", "torso", "mu",
                                 "fz_min", "cop_region", "torque_limit", "torso_weight", "force_weight",
-                                "torsion_radius", "com_integral", "com_schedule", "torso_error_limit"});
+                                "torsion_radius", "com_integral", "com_schedule", "torso_error_limit",
+                                "hip_strategy"});
     BalanceParameters<nj>& b = c.balance;
     b.foot_linear = r.gains(n, p, "foot_linear");
     b.foot_angular = r.gains(n, p, "foot_angular");
@@ -232,6 +233,13 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
       if (!(b.com_dcm_high > b.com_dcm_low)) {
         r.fail("'" + q + ".dcm_high' must exceed dcm_low");
       }
+    }
+    if (n["hip_strategy"]) {  // optional, beyond the paper; max_tilt .inf = off
+      const YAML::Node g = r.map(n, p, "hip_strategy", {"max_tilt", "stiffness", "damping"});
+      const std::string q = p + ".hip_strategy";
+      b.hip_max_tilt = r.atLeast(g, q, "max_tilt", 0.0, true, true);
+      b.hip_stiffness = r.atLeast(g, q, "stiffness", 0.0, false);
+      b.hip_damping = r.atLeast(g, q, "damping", 0.0, false);
     }
     b.torso = r.gains(n, p, "torso");
     if (n["torso_error_limit"]) b.torso_error_limit = r.atLeast(n, p, "torso_error_limit", 0.0, true, true);  // beyond the paper; .inf = off

@@ -10,18 +10,26 @@
 //   as the capture-point error |e + ė/ω| (ω = √(g / CoM height above the feet)) grows from
 //   dcm_low to dcm_high, so soft gains ride out what the ankles can absorb and stiff ones act
 //   when the capture point nears the sole edge.
+//   a hip-strategy budget: the horizontal demand is clamped to what the CoP region can give plus
+//   the angular momentum the torso may still take. With the net CoP p on the soles and f_z ≈ m g,
+//   L̇_G = (p − c) × f gives a_x = ω²(c_x − p_x) − L̇_y/(m h), a_y = ω²(c_y − p_y) + L̇_x/(m h)
+//   (h = CoM height above the soles); L̇ is allowed within [−K (θ + θ_max) − D L, K (θ_max − θ) − D L]
+//   per axis, θ the torso's tilt from its reference: a spring-damper that gives the hip strategy
+//   its full rate while the torso is upright and stops the torso before θ_max.
 // so [A_G,lin 0] x = m a − (Ȧ_G v)_lin (3 rows, N).
 // The vertical row has its own gains (`vertical`): the CoM height does not matter for balance,
 // and a stiff height loop straightens the knees when the torso leans (docs/tasks.md).
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Core>
 
 #include "hqp/task.hpp"
 #include "model/data.hpp"
 #include "tasks/contact_layout.hpp"
+#include "tasks/orientation_error.hpp"
 #include "tasks/pd_gains.hpp"
 #include "tasks/references.hpp"
 
@@ -63,6 +71,7 @@ class LinearMomentumTask : public hqp::Task<3, Layout::nx> {
       integral_ = (integral_ + dt_ * error_.head<2>()).cwiseMax(-integral_limit_).cwiseMin(integral_limit_);
       a.head<2>() += ki_ * integral_;
     }
+    if (budget_tilt_ < std::numeric_limits<double>::infinity()) clampToHipBudget(dyn, refs, a);
     a.z() = refs.com_acceleration.z() + vertical.kp * error_.z() + vertical.kd * derr.z();
     this->A.template leftCols<nv>() = dyn.Ag().template topRows<3>();
     this->b = dyn.mass() * a - dyn.dAg_v().template head<3>();
@@ -79,6 +88,11 @@ class LinearMomentumTask : public hqp::Task<3, Layout::nx> {
     high_ = p.com_high;
     dcm_low_ = p.com_dcm_low;
     dcm_high_ = p.com_dcm_high;
+    budget_tilt_ = p.hip_max_tilt;
+    budget_stiffness_ = p.hip_stiffness;
+    budget_damping_ = p.hip_damping;
+    cop_lo_ = {p.sole_x_min, p.sole_y_min};
+    cop_hi_ = {p.sole_x_max, p.sole_y_max};
     resetState();
   }
 
@@ -92,12 +106,43 @@ class LinearMomentumTask : public hqp::Task<3, Layout::nx> {
   const Eigen::Vector3d& error() const { return error_; }
 
  private:
+  // The horizontal rows of `a` clamped to the CoP region's range plus the hip-strategy budget.
+  template <class Dyn>
+  void clampToHipBudget(const Dyn& dyn, const References<NC>& refs, Eigen::Vector3d& a) const noexcept {
+    Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    double z_feet = 0.0;
+    for (int c = 0; c < NC; ++c) {
+      const Eigen::Isometry3d& X = refs.contact_pose[c];
+      for (int k = 0; k < 4; ++k) {  // the corners of the CoP region (a point for point feet)
+        const Eigen::Vector3d corner(k & 1 ? cop_hi_.x() : cop_lo_.x(), k & 2 ? cop_hi_.y() : cop_lo_.y(), 0.0);
+        const Eigen::Vector2d p =
+            (X * (Layout::contact_dim == 6 ? corner : Eigen::Vector3d::Zero())).template head<2>();
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+      }
+      z_feet += X.translation().z() / NC;
+    }
+    const Eigen::Vector3d& c = dyn.com();
+    const double h = std::max(0.1, c.z() - z_feet), w2 = hqp::model::kGravity / h, mh = dyn.mass() * h;
+    const Eigen::Vector3d L = dyn.hg().template tail<3>();
+    // θ: the torso's rotation from its reference (world rotation vector).
+    const Eigen::Vector3d tilt = -orientationError(refs.torso_orientation, dyn.placement(Layout::torso_frame).linear());
+    const double K = budget_stiffness_, D = budget_damping_, t = budget_tilt_;
+    const auto dL_lo = [&](int i) { return -K * (tilt[i] + t) - D * L[i]; };
+    const auto dL_hi = [&](int i) { return K * (t - tilt[i]) - D * L[i]; };
+    a.x() = std::clamp(a.x(), w2 * (c.x() - hi.x()) - dL_hi(1) / mh, w2 * (c.x() - lo.x()) - dL_lo(1) / mh);
+    a.y() = std::clamp(a.y(), w2 * (c.y() - hi.y()) + dL_lo(0) / mh, w2 * (c.y() - lo.y()) + dL_hi(0) / mh);
+  }
+
   Eigen::Vector3d error_ = Eigen::Vector3d::Zero();
   Eigen::Vector2d integral_ = Eigen::Vector2d::Zero();  // m·s, horizontal
   double ki_ = 0.0, integral_limit_ = 0.0, dt_ = 0.001;
   bool reset_on_crossing_ = false;
   PdGains high_{};
   double dcm_low_ = 0.0, dcm_high_ = 0.0;  // m; dcm_high <= dcm_low: no schedule
+  double budget_tilt_ = std::numeric_limits<double>::infinity();  // rad; ∞: no budget
+  double budget_stiffness_ = 0.0, budget_damping_ = 0.0;          // N·m/rad, 1/s
+  Eigen::Vector2d cop_lo_{-0.1, -0.04}, cop_hi_{0.1, 0.04};          // CoP region, sole frame (m)
 };
 
 }  // namespace hqp::tasks

@@ -534,6 +534,54 @@ TEST_F(BalanceHierarchy, ComIntegralResetOnSignChange) {
 // Checked by central differences of the model's frame and CoM velocities along (v, q̈*).
 // Level-4 force rows: force_weight everywhere except the torsion m_z of each sole, which weighs
 // force_weight / torsion_radius² (1 N·m of torsion as costly as 1 / r N of force).
+// The hip-strategy budget of the CoM rows, at rest (L = 0), checked on the solution's contact
+// wrenches: L̇_G = Σ_c (p_c − c) × f_c + m_c (Newton–Euler about the CoM; gravity has no moment
+// there). A demand far beyond the soles (0.3 m ahead / to the side) may buy at most K θ_max of
+// L̇ with the torso upright and none with the torso already θ_max from its reference; without the
+// budget level 3 takes what it needs.
+TEST_F(BalanceHierarchy, HipStrategyBudgetBoundsTheAngularMomentumRate) {
+  const auto angularMomentumRate = [&](const VectorX& x) {
+    Eigen::Vector3d dL = Eigen::Vector3d::Zero();
+    for (int c = 0; c < 2; ++c) {
+      const Eigen::Vector3d f = x.segment<3>(Layout::forceIndex(c)), m = x.segment<3>(Layout::forceIndex(c) + 3);
+      dL += (dyn.placement(c).translation() - dyn.com()).cross(f) + m;
+    }
+    return dL;
+  };
+  const double K = 40.0, tilt = 0.5;
+  hqp::tasks::BalanceParameters<Robot::nj> off = params;
+  params.hip_max_tilt = tilt;
+  params.hip_stiffness = K;
+  params.hip_damping = 10.0;
+  ASSERT_EQ(angularMomentumRate(VectorX::Zero()).norm(), 0.0);
+  Refs ahead = refs, aside = refs, tilted = refs;
+  ahead.com.x() += 0.3;
+  aside.com.y() += 0.3;
+  tilted.com.x() += 0.3;
+  // The reference pitched θ_max forward of the torso: the torso is θ_max back from it.
+  tilted.torso_orientation = Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitY()) * dyn.placement(Layout::torso_frame).linear();
+  Hqp wbc;
+  ASSERT_EQ(solve(wbc, ahead), hqp::QpStatus::Optimal);
+  expectContactConstraints(wbc.x(), 1e-9);
+  EXPECT_NEAR(angularMomentumRate(wbc.x()).y(), -K * tilt, 1e-6);
+  for (int c = 0; c < 2; ++c) {  // on the heels: the CoP gives all it can
+    const auto w = soleWrench(dyn, wbc.x(), c);
+    EXPECT_NEAR(-w(4) / w(2), params.sole_x_min, 1e-9) << "foot " << c;
+  }
+  ASSERT_EQ(solve(wbc, tilted), hqp::QpStatus::Optimal);
+  EXPECT_NEAR(angularMomentumRate(wbc.x()).y(), 0.0, 1e-6);
+  // Sideways the net CoP cannot reach the outer edge (the other foot keeps f_z ≥ fz_min), so L̇_x
+  // lies between K θ_max and K θ_max + fz_min · (distance between the feet).
+  ASSERT_EQ(solve(wbc, aside), hqp::QpStatus::Optimal);
+  const double gap = (dyn.placement(0).translation() - dyn.placement(1).translation()).norm();
+  EXPECT_GE(angularMomentumRate(wbc.x()).x(), K * tilt - 1e-6);
+  EXPECT_LE(angularMomentumRate(wbc.x()).x(), K * tilt + params.fz_min * gap + 1e-6);
+  // Without the budget (the paper's task) the same demand pitches the torso much harder.
+  params = off;
+  ASSERT_EQ(solve(wbc, ahead), hqp::QpStatus::Optimal);
+  EXPECT_LT(angularMomentumRate(wbc.x()).y(), -2.0 * K * tilt);
+}
+
 TEST_F(BalanceHierarchy, TorsionRowsOfTheForceTaskWeighByTheTorsionRadius) {
   hqp::tasks::ContactForceTask<Layout> force;
   force.configure(params);

@@ -102,6 +102,9 @@ TEST(ControllerConfig, ShippedFileLoads) {
   EXPECT_EQ(c.balance.com_integral_limit, 0.03);
   EXPECT_TRUE(c.balance.com_integral_reset);
   EXPECT_EQ(c.balance.torso_error_limit, 0.2);
+  EXPECT_EQ(c.balance.hip_max_tilt, 0.7);
+  EXPECT_EQ(c.balance.hip_stiffness, 100.0);
+  EXPECT_EQ(c.balance.hip_damping, 10.0);
   EXPECT_TRUE(c.planner.hold_tipping_axis);
   EXPECT_EQ(c.balance.com_vertical.kp, 9.0);
   EXPECT_EQ(c.balance.com_vertical.kd, 6.0);
@@ -171,6 +174,9 @@ TEST(ControllerConfig, NegativeOrInvalidValuesAreRejected) {
   expectRejected("com:          {kp: 4, kd: 3}", "com:          {kp: -4, kd: 3}", "balance.com.kp");
   expectRejected("reset_on_crossing: true", "reset_on_crossing: 1.5", "balance.com_integral.reset_on_crossing");
   expectRejected("  torso_error_limit: 0.2", "  torso_error_limit: 0", "balance.torso_error_limit");
+  expectRejected("{max_tilt: 0.7,", "{max_tilt: 0,", "balance.hip_strategy.max_tilt");
+  expectRejected("stiffness: 100, damping: 10}", "stiffness: 100, damping: -1}", "balance.hip_strategy.damping");
+  expectRejected("stiffness: 100, damping: 10}", "stiffness: 100}", "balance.hip_strategy.damping");
   expectRejected("dcm_low: 0.07, dcm_high: 0.10", "dcm_low: 0.10, dcm_high: 0.07", "balance.com_schedule.dcm_high");
   expectRejected("com_integral: {ki: 4,", "com_integral: {ki: -4,", "balance.com_integral.ki");
   expectRejected("  hold_tipping_axis: true", "  hold_tipping_axis: 2x", "planner.hold_tipping_axis");
@@ -247,6 +253,10 @@ TEST(ControllerConfig, MovingSupportOptionsDefaultToThePaperRule) {
   EditedConfig k("  torso_error_limit: 0.2", "  # (removed)");  // the saturated torso PD: off
   ASSERT_TRUE(k.found());
   EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(k.path()).balance.torso_error_limit,
+            std::numeric_limits<double>::infinity());
+  EditedConfig m("  hip_strategy: {", "  # hip_strategy: {");  // the hip-strategy budget: off
+  ASSERT_TRUE(m.found());
+  EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(m.path()).balance.hip_max_tilt,
             std::numeric_limits<double>::infinity());
 }
 
