@@ -2,14 +2,14 @@
 // Level 3 task, eq. 2 with the centroidal momentum matrix (Wensing & Orin 2016):
 //   Ṗ = A_G,lin q̈ + (Ȧ_G v)_lin = m a,   a = a_ff + kp e + kd ė,
 //   e = r_CoM,ref − r_CoM,  ė = v_CoM,ref − v_CoM,
-// Two extensions beyond the paper on the horizontal rows, both off by default (docs/tasks.md):
+// Three extensions beyond the paper on the horizontal rows, all off by default (docs/tasks.md):
 //   ki ∫e dt, the integral clamped per axis and, optionally, reset to 0 on an axis whose error
 //   has the opposite sign of its integral (a Clegg integrator): what it stored while the push
 //   carried the CoM away then cannot carry the CoM past its reference on the way back;
 //   a capture-point gain schedule: per axis the gains blend from (kp, kd) to (kp_high, kd_high)
 //   as the capture-point error |e + ė/ω| (ω = √(g / CoM height above the feet)) grows from
 //   dcm_low to dcm_high, so soft gains ride out what the ankles can absorb and stiff ones act
-//   when the capture point nears the sole edge.
+//   when the capture point nears the sole edge;
 //   a hip-strategy budget: the horizontal demand is clamped to what the CoP region can give plus
 //   the angular momentum the torso may still take. With the net CoP p on the soles and f_z ≈ m g,
 //   L̇_G = (p − c) × f gives a_x = ω²(c_x − p_x) − L̇_y/(m h), a_y = ω²(c_y − p_y) + L̇_x/(m h)
@@ -52,9 +52,7 @@ class LinearMomentumTask : public hqp::Task<3, Layout::nx> {
     const Eigen::Vector3d derr = refs.com_velocity - dyn.vcom();
     Eigen::Vector3d a = refs.com_acceleration + gains.kp * error_ + gains.kd * derr;
     if (dcm_high_ > dcm_low_) {
-      double z_feet = 0.0;
-      for (int c = 0; c < NC; ++c) z_feet += refs.contact_pose[c].translation().z() / NC;
-      const double omega = std::sqrt(hqp::model::kGravity / std::max(0.1, refs.com.z() - z_feet));
+      const double omega = std::sqrt(hqp::model::kGravity / std::max(0.1, refs.com.z() - feetHeight(refs)));
       for (int i = 0; i < 2; ++i) {
         const double xi = std::abs(error_[i] + derr[i] / omega);
         const double s = std::clamp((xi - dcm_low_) / (dcm_high_ - dcm_low_), 0.0, 1.0);
@@ -71,7 +69,7 @@ class LinearMomentumTask : public hqp::Task<3, Layout::nx> {
       integral_ = (integral_ + dt_ * error_.head<2>()).cwiseMax(-integral_limit_).cwiseMin(integral_limit_);
       a.head<2>() += ki_ * integral_;
     }
-    if (budget_tilt_ < std::numeric_limits<double>::infinity()) clampToHipBudget(dyn, refs, a);
+    if (hip_tilt_ < std::numeric_limits<double>::infinity()) clampToHipBudget(dyn, refs, a);
     a.z() = refs.com_acceleration.z() + vertical.kp * error_.z() + vertical.kd * derr.z();
     this->A.template leftCols<nv>() = dyn.Ag().template topRows<3>();
     this->b = dyn.mass() * a - dyn.dAg_v().template head<3>();
@@ -88,9 +86,9 @@ class LinearMomentumTask : public hqp::Task<3, Layout::nx> {
     high_ = p.com_high;
     dcm_low_ = p.com_dcm_low;
     dcm_high_ = p.com_dcm_high;
-    budget_tilt_ = p.hip_max_tilt;
-    budget_stiffness_ = p.hip_stiffness;
-    budget_damping_ = p.hip_damping;
+    hip_tilt_ = p.hip_max_tilt;
+    hip_stiffness_ = p.hip_stiffness;
+    hip_damping_ = p.hip_damping;
     cop_lo_ = {p.sole_x_min, p.sole_y_min};
     cop_hi_ = {p.sole_x_max, p.sole_y_max};
     resetState();
@@ -106,11 +104,17 @@ class LinearMomentumTask : public hqp::Task<3, Layout::nx> {
   const Eigen::Vector3d& error() const { return error_; }
 
  private:
+  // Mean height of the reference contacts (m): the LIP's ground.
+  static double feetHeight(const References<NC>& refs) noexcept {
+    double z = 0.0;
+    for (int c = 0; c < NC; ++c) z += refs.contact_pose[c].translation().z() / NC;
+    return z;
+  }
+
   // The horizontal rows of `a` clamped to the CoP region's range plus the hip-strategy budget.
   template <class Dyn>
   void clampToHipBudget(const Dyn& dyn, const References<NC>& refs, Eigen::Vector3d& a) const noexcept {
     Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-    double z_feet = 0.0;
     for (int c = 0; c < NC; ++c) {
       const Eigen::Isometry3d& X = refs.contact_pose[c];
       for (int k = 0; k < 4; ++k) {  // the corners of the CoP region (a point for point feet)
@@ -120,14 +124,13 @@ class LinearMomentumTask : public hqp::Task<3, Layout::nx> {
         lo = lo.cwiseMin(p);
         hi = hi.cwiseMax(p);
       }
-      z_feet += X.translation().z() / NC;
     }
     const Eigen::Vector3d& c = dyn.com();
-    const double h = std::max(0.1, c.z() - z_feet), w2 = hqp::model::kGravity / h, mh = dyn.mass() * h;
+    const double h = std::max(0.1, c.z() - feetHeight(refs)), w2 = hqp::model::kGravity / h, mh = dyn.mass() * h;
     const Eigen::Vector3d L = dyn.hg().template tail<3>();
     // θ: the torso's rotation from its reference (world rotation vector).
     const Eigen::Vector3d tilt = -orientationError(refs.torso_orientation, dyn.placement(Layout::torso_frame).linear());
-    const double K = budget_stiffness_, D = budget_damping_, t = budget_tilt_;
+    const double K = hip_stiffness_, D = hip_damping_, t = hip_tilt_;
     const auto dL_lo = [&](int i) { return -K * (tilt[i] + t) - D * L[i]; };
     const auto dL_hi = [&](int i) { return K * (t - tilt[i]) - D * L[i]; };
     a.x() = std::clamp(a.x(), w2 * (c.x() - hi.x()) - dL_hi(1) / mh, w2 * (c.x() - lo.x()) - dL_lo(1) / mh);
@@ -140,9 +143,9 @@ class LinearMomentumTask : public hqp::Task<3, Layout::nx> {
   bool reset_on_crossing_ = false;
   PdGains high_{};
   double dcm_low_ = 0.0, dcm_high_ = 0.0;  // m; dcm_high <= dcm_low: no schedule
-  double budget_tilt_ = std::numeric_limits<double>::infinity();  // rad; ∞: no budget
-  double budget_stiffness_ = 0.0, budget_damping_ = 0.0;          // N·m/rad, 1/s
-  Eigen::Vector2d cop_lo_{-0.1, -0.04}, cop_hi_{0.1, 0.04};          // CoP region, sole frame (m)
+  double hip_tilt_ = std::numeric_limits<double>::infinity();  // rad; ∞: no budget
+  double hip_stiffness_ = 0.0, hip_damping_ = 0.0;                 // N·m/rad, 1/s
+  Eigen::Vector2d cop_lo_{-0.1, -0.04}, cop_hi_{0.1, 0.04};        // CoP region, sole frame (m)
 };
 
 }  // namespace hqp::tasks
