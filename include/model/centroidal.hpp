@@ -37,7 +37,8 @@ inline void centroidalFromComposite(Data<Robot>& d,
   }
   d.Jcom = d.Ag.template topRows<3>() / d.Itot.m;
   d.vcom.noalias() = d.Jcom * v;
-  d.hg.noalias() = d.Ag * v;
+  d.hg.template head<3>() = d.Itot.m * d.vcom;  // P = m v_CoM: the linear rows are not formed twice
+  d.hg.template tail<3>().noalias() = d.Ag.template bottomRows<3>() * v;
 }
 
 // d.dAg_v from the RNEA total force (kTau after a q̈ = 0 forward pass with forces).
