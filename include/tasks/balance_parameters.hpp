@@ -51,6 +51,9 @@ struct BalanceParameters {
   // CoP rectangle in the sole frame (m): the 0.22 × 0.10 sole box is centred on the sole frame
   // (robots/walker3/README.md); 1 cm is kept from every edge for model error.
   double sole_x_min = -0.10, sole_x_max = 0.10, sole_y_min = -0.04, sole_y_max = 0.04;
+  // N·m, beyond the paper (cop_constraint.hpp): a moment kept from every edge of the CoP region, so
+  // that a torque error of this size cannot tip a lightly loaded foot; 0 = the paper's CoP region.
+  double cop_moment_margin = 0.0;
   VectorJ tau_max = VectorJ::Constant(hqp::kInf);  // symmetric limits |τ| ≤ tau_max (N·m)
   // Level-4 row weights: 1 rad/s² of torso error weighs as much as ~32 N of force error.
   double torso_weight = 1.0;

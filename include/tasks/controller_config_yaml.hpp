@@ -212,7 +212,7 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
                                {"foot_linear", "foot_angular", "com", "com_vertical", "torso", "mu",
                                 "fz_min", "cop_region", "torque_limit", "torso_weight", "force_weight",
                                 "torsion_radius", "com_integral", "com_schedule", "torso_error_limit",
-                                "hip_strategy"});
+                                "hip_strategy", "cop_moment_margin"});
     BalanceParameters<nj>& b = c.balance;
     b.foot_linear = r.gains(n, p, "foot_linear");
     b.foot_angular = r.gains(n, p, "foot_angular");
@@ -246,6 +246,7 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
     b.mu = r.atLeast(n, p, "mu", 0.0, true);
     b.fz_min = r.atLeast(n, p, "fz_min", 0.0, false);
     r.rectangle(n, p, "cop_region", b.sole_x_min, b.sole_x_max, b.sole_y_min, b.sole_y_max);
+    if (n["cop_moment_margin"]) b.cop_moment_margin = r.atLeast(n, p, "cop_moment_margin", 0.0, false);  // beyond the paper
     b.torso_weight = r.atLeast(n, p, "torso_weight", 0.0, false);
     b.force_weight = r.atLeast(n, p, "force_weight", 0.0, false);
     b.torsion_radius = r.atLeast(n, p, "torsion_radius", 0.0, true);

@@ -6,6 +6,10 @@
 // is linear in F: 4 one-sided rows per foot, D x ≤ 0, in the order
 //   −m_y − x_max f_z ≤ 0,   m_y + x_min f_z ≤ 0,   m_x − y_max f_z ≤ 0,   −m_x + y_min f_z ≤ 0.
 // Only for flat feet (CD = 6).
+// Beyond the paper, each row's bound may be −δ (`moment_margin`, N·m) instead of 0: the CoP then
+// stays δ / f_sz inside the rectangle, a margin that grows as the foot unloads. A joint-torque error
+// moves the true CoP by about δτ / f_sz, so a fixed distance from the edge protects a loaded foot
+// and not a light one; a fixed moment protects both. It implies f_sz ≥ 2δ / (y_max − y_min).
 
 #include <Eigen/Core>
 
@@ -26,6 +30,7 @@ class CopConstraint : public hqp::Constraint<4 * Layout::num_contacts, Layout::n
 
   // CoP rectangle in the sole frame (m).
   double x_min = -0.10, x_max = 0.10, y_min = -0.04, y_max = 0.04;
+  double moment_margin = 0.0;  // N·m, δ
 
   CopConstraint() {
     this->name = "center_of_pressure";
@@ -58,6 +63,8 @@ class CopConstraint : public hqp::Constraint<4 * Layout::num_contacts, Layout::n
     x_max = p.sole_x_max;
     y_min = p.sole_y_min;
     y_max = p.sole_y_max;
+    moment_margin = p.cop_moment_margin;
+    this->upper.setConstant(-moment_margin);
   }
 };
 

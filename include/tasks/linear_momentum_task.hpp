@@ -91,6 +91,7 @@ class LinearMomentumTask : public hqp::Task<3, Layout::nx> {
     hip_damping_ = p.hip_damping;
     cop_lo_ = {p.sole_x_min, p.sole_y_min};
     cop_hi_ = {p.sole_x_max, p.sole_y_max};
+    cop_moment_margin_ = p.cop_moment_margin;
     resetState();
   }
 
@@ -125,6 +126,11 @@ class LinearMomentumTask : public hqp::Task<3, Layout::nx> {
         hi = hi.cwiseMax(p);
       }
     }
+    // The CoP constraint's moment margin δ on every contact moves the whole robot's CoP range in
+    // by NC δ over the weight (the total normal force standing still).
+    const double shrink = NC * cop_moment_margin_ / (dyn.mass() * hqp::model::kGravity);
+    lo.array() += shrink;
+    hi.array() -= shrink;
     const Eigen::Vector3d& c = dyn.com();
     const double h = std::max(0.1, c.z() - feetHeight(refs)), w2 = hqp::model::kGravity / h, mh = dyn.mass() * h;
     const Eigen::Vector3d L = dyn.hg().template tail<3>();
@@ -146,6 +152,7 @@ class LinearMomentumTask : public hqp::Task<3, Layout::nx> {
   double hip_tilt_ = std::numeric_limits<double>::infinity();  // rad; ∞: no budget
   double hip_stiffness_ = 0.0, hip_damping_ = 0.0;                 // N·m/rad, 1/s
   Eigen::Vector2d cop_lo_{-0.1, -0.04}, cop_hi_{0.1, 0.04};        // CoP region, sole frame (m)
+  double cop_moment_margin_ = 0.0;                                 // N·m, the CoP rows' δ
 };
 
 }  // namespace hqp::tasks

@@ -175,11 +175,12 @@ class BalanceHierarchy : public ::testing::Test {
       EXPECT_GE(fz, params.fz_min - tol) << "foot " << c;
       EXPECT_LE(std::abs(w(0)), k * fz + tol) << "foot " << c;
       EXPECT_LE(std::abs(w(1)), k * fz + tol) << "foot " << c;
-      const double cop_x = -w(4) / fz, cop_y = w(3) / fz;
-      EXPECT_GE(cop_x, params.sole_x_min - tol) << "foot " << c;
-      EXPECT_LE(cop_x, params.sole_x_max + tol) << "foot " << c;
-      EXPECT_GE(cop_y, params.sole_y_min - tol) << "foot " << c;
-      EXPECT_LE(cop_y, params.sole_y_max + tol) << "foot " << c;
+      // The CoP keeps δ / f_z from the region's edges (δ = the moment margin, 0 by default).
+      const double cop_x = -w(4) / fz, cop_y = w(3) / fz, inset = params.cop_moment_margin / fz;
+      EXPECT_GE(cop_x, params.sole_x_min + inset - tol) << "foot " << c;
+      EXPECT_LE(cop_x, params.sole_x_max - inset + tol) << "foot " << c;
+      EXPECT_GE(cop_y, params.sole_y_min + inset - tol) << "foot " << c;
+      EXPECT_LE(cop_y, params.sole_y_max - inset + tol) << "foot " << c;
     }
   }
 
@@ -580,6 +581,43 @@ TEST_F(BalanceHierarchy, HipStrategyBudgetBoundsTheAngularMomentumRate) {
   params = off;
   ASSERT_EQ(solve(wbc, ahead), hqp::QpStatus::Optimal);
   EXPECT_LT(angularMomentumRate(wbc.x()).y(), -2.0 * K * tilt);
+}
+
+// The CoP rows' moment margin δ: a foot's CoP stops δ / f_z inside its region, so the lighter foot
+// keeps further from its edge; the two y rows together imply f_z ≥ 2δ / (y_max − y_min).
+TEST_F(BalanceHierarchy, CopMomentMarginGrowsAsTheFootUnloads) {
+  const double delta = 1.0;
+  params.cop_moment_margin = delta;
+  params.hip_max_tilt = 0.5;  // the budget bounds the torso's share, so the CoPs must give all they can
+  params.hip_stiffness = 40.0;
+  params.hip_damping = 10.0;
+  Refs ahead = refs, aside = refs;
+  ahead.com.x() += 0.3;
+  aside.com.y() += 0.3;
+  Hqp wbc;
+  ASSERT_EQ(solve(wbc, ahead), hqp::QpStatus::Optimal);
+  expectContactConstraints(wbc.x(), 1e-9);
+  for (int c = 0; c < 2; ++c) {  // both CoPs on the heel bound, δ / f_z in from it
+    const auto w = soleWrench(dyn, wbc.x(), c);
+    EXPECT_NEAR(w(4) + params.sole_x_min * w(2), -delta, 1e-6) << "foot " << c;  // m_y at its bound
+    EXPECT_NEAR(-w(4) / w(2), params.sole_x_min + delta / w(2), 1e-8) << "foot " << c;
+  }
+  ASSERT_EQ(solve(wbc, aside), hqp::QpStatus::Optimal);
+  expectContactConstraints(wbc.x(), 1e-9);
+  const auto wl = soleWrench(dyn, wbc.x(), 0), wr = soleWrench(dyn, wbc.x(), 1);
+  const double light_load = std::min(wl(2), wr(2)), heavy_load = std::max(wl(2), wr(2));
+  ASSERT_LT(light_load, 0.5 * heavy_load);  // the demand aside unloads one foot
+  EXPECT_GE(light_load, 2.0 * delta / (params.sole_y_max - params.sole_y_min) - 1e-9);
+  for (const auto& w : {wl, wr}) {  // both on the bound towards −y, the lighter one further in
+    EXPECT_NEAR(w(3) / w(2), params.sole_y_min + delta / w(2), 1e-9);
+  }
+  // The same demand without the margin puts both CoPs on the region's edge.
+  params.cop_moment_margin = 0.0;
+  ASSERT_EQ(solve(wbc, aside), hqp::QpStatus::Optimal);
+  for (int c = 0; c < 2; ++c) {
+    const auto w = soleWrench(dyn, wbc.x(), c);
+    EXPECT_NEAR(w(3) / w(2), params.sole_y_min, 1e-9) << "foot " << c;
+  }
 }
 
 TEST_F(BalanceHierarchy, TorsionRowsOfTheForceTaskWeighByTheTorsionRadius) {

@@ -105,6 +105,7 @@ TEST(ControllerConfig, ShippedFileLoads) {
   EXPECT_EQ(c.balance.hip_max_tilt, 0.7);
   EXPECT_EQ(c.balance.hip_stiffness, 100.0);
   EXPECT_EQ(c.balance.hip_damping, 10.0);
+  EXPECT_EQ(c.balance.cop_moment_margin, 0.0);  // optional, off for Walker3
   EXPECT_TRUE(c.planner.hold_tipping_axis);
   EXPECT_EQ(c.balance.com_vertical.kp, 9.0);
   EXPECT_EQ(c.balance.com_vertical.kd, 6.0);
@@ -174,6 +175,7 @@ TEST(ControllerConfig, NegativeOrInvalidValuesAreRejected) {
   expectRejected("com:          {kp: 4, kd: 3}", "com:          {kp: -4, kd: 3}", "balance.com.kp");
   expectRejected("reset_on_crossing: true", "reset_on_crossing: 1.5", "balance.com_integral.reset_on_crossing");
   expectRejected("  torso_error_limit: 0.2", "  torso_error_limit: 0", "balance.torso_error_limit");
+  expectRejected("  torso_weight: 1.0", "  cop_moment_margin: -0.1\n  torso_weight: 1.0", "balance.cop_moment_margin");
   expectRejected("{max_tilt: 0.7,", "{max_tilt: 0,", "balance.hip_strategy.max_tilt");
   expectRejected("stiffness: 100, damping: 10}", "stiffness: 100, damping: -1}", "balance.hip_strategy.damping");
   expectRejected("stiffness: 100, damping: 10}", "stiffness: 100}", "balance.hip_strategy.damping");
@@ -258,6 +260,9 @@ TEST(ControllerConfig, MovingSupportOptionsDefaultToThePaperRule) {
   ASSERT_TRUE(m.found());
   EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(m.path()).balance.hip_max_tilt,
             std::numeric_limits<double>::infinity());
+  EditedConfig r("  torso_weight: 1.0", "  cop_moment_margin: 1.5\n  torso_weight: 1.0");  // switched on
+  ASSERT_TRUE(r.found());
+  EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(r.path()).balance.cop_moment_margin, 1.5);
 }
 
 TEST(ControllerConfig, OtherSolverAndInfiniteLeakLoad) {
