@@ -67,7 +67,27 @@ class DualActiveSetQp {
       if (!(beta != 0.0) || !std::isfinite(beta)) return false;
       v[i] = beta;
       if (tau == 0.0) continue;
-      for (int j = i + 1; j <= n; ++j) {  // columns i+1 .. n−1, then c (j = n)
+      // Columns i+1 .. n−1, then c (j = n), two at a time: their dot products are independent
+      // chains (each summed in its own order, so the result does not change).
+      int j = i + 1;
+      for (; j + 1 <= n; j += 2) {
+        double* x = &F_(0, j);
+        double* y = j + 1 < n ? &F_(0, j + 1) : c_.data();
+        double t = x[i], s = y[i];
+        for (int l = i + 1; l < r; ++l) {
+          t += v[l] * x[l];
+          s += v[l] * y[l];
+        }
+        t *= tau;
+        s *= tau;
+        x[i] -= t;
+        y[i] -= s;
+        for (int l = i + 1; l < r; ++l) {
+          x[l] -= t * v[l];
+          y[l] -= s * v[l];
+        }
+      }
+      if (j <= n) {
         double* x = j < n ? &F_(0, j) : c_.data();
         double t = x[i];
         for (int l = i + 1; l < r; ++l) t += v[l] * x[l];

@@ -2,7 +2,10 @@
 // Tolerances and limits of ActiveSetQp and DualActiveSetQp (include/hqp/active_set_qp.hpp,
 // include/hqp/dual_active_set_qp.hpp); HqpWbc and WqpWbc pass them to every QP.
 
+#include <Eigen/Core>
+
 #include <cmath>
+#include <type_traits>
 
 namespace hqp {
 
@@ -21,9 +24,19 @@ struct QpSettings {
 namespace detail {
 
 // True if every entry v of m is finite with |v| ≤ max (NaN compares false).
+// Plain matrices in one branch-free pass over the storage, which vectorizes (Eigen's all()
+// tests one entry at a time).
 template <class M>
 bool withinMagnitude(const M& m, double max) {
-  return (m.array().abs() <= max).all();
+  if constexpr (std::is_base_of_v<Eigen::PlainObjectBase<M>, M>) {
+    const double* v = m.data();
+    const Eigen::Index size = m.size();
+    unsigned bad = 0;  // NaN fails |v| ≤ max as well
+    for (Eigen::Index i = 0; i < size; ++i) bad |= !(std::abs(v[i]) <= max);
+    return bad == 0;
+  } else {
+    return (m.array().abs() <= max).all();
+  }
 }
 
 // A bound pair is in the contract if neither is NaN, lower ≠ +inf, upper ≠ −inf and each

@@ -17,25 +17,56 @@
 namespace hqp::detail {
 
 // strip ← strip H_first ⋯ H_{last−1} on the columns [first, cols) of a local 8-row block.
+// t = strip v of the next reflector is summed while this one updates the columns, so each
+// column is loaded once per reflector; every sum keeps its accumulator and order (t0 gets
+// column i, then j ≡ i+1, and the tail past the last full group of 4; t1..t3 the others),
+// so the result is bit for bit that of a dot pass and an update pass.
 template <int MaxCols, class MatV, class VecTau>
 inline void reflectStrip(Eigen::Matrix<double, 8, MaxCols>& strip, int cols, const MatV& V,
                          const VecTau& tau, int first, int last) {
   using Vec = Eigen::Matrix<double, 8, 1>;
-  for (int i = first; i < last; ++i) {
-    const double ti = tau(i);
-    if (ti == 0.0) continue;
-    Vec t0 = strip.col(i), t1 = Vec::Zero(), t2 = Vec::Zero(), t3 = Vec::Zero();
-    int j = i + 1;
-    for (; j + 3 < cols; j += 4) {
-      t0.noalias() += V(j, i) * strip.col(j);
-      t1.noalias() += V(j + 1, i) * strip.col(j + 1);
-      t2.noalias() += V(j + 2, i) * strip.col(j + 2);
-      t3.noalias() += V(j + 3, i) * strip.col(j + 3);
-    }
-    for (; j < cols; ++j) t0.noalias() += V(j, i) * strip.col(j);
-    const Vec t = ti * ((t0 + t1) + (t2 + t3));
+  int i = first;
+  while (i < last && tau(i) == 0.0) ++i;
+  if (i >= last) return;
+  Vec t0 = strip.col(i), t1 = Vec::Zero(), t2 = Vec::Zero(), t3 = Vec::Zero();
+  int j = i + 1;
+  for (; j + 3 < cols; j += 4) {
+    t0.noalias() += V(j, i) * strip.col(j);
+    t1.noalias() += V(j + 1, i) * strip.col(j + 1);
+    t2.noalias() += V(j + 2, i) * strip.col(j + 2);
+    t3.noalias() += V(j + 3, i) * strip.col(j + 3);
+  }
+  for (; j < cols; ++j) t0.noalias() += V(j, i) * strip.col(j);
+  while (i < last) {
+    const Vec t = tau(i) * ((t0 + t1) + (t2 + t3));
+    int n = i + 1;  // the next reflector that does something
+    while (n < last && tau(n) == 0.0) ++n;
     strip.col(i) -= t;
-    for (j = i + 1; j < cols; ++j) strip.col(j).noalias() -= V(j, i) * t;
+    if (n >= last) {
+      for (j = i + 1; j < cols; ++j) strip.col(j).noalias() -= V(j, i) * t;
+      return;
+    }
+    for (j = i + 1; j < n; ++j) strip.col(j).noalias() -= V(j, i) * t;
+    strip.col(n).noalias() -= V(n, i) * t;
+    t0 = strip.col(n);
+    t1.setZero();
+    t2.setZero();
+    t3.setZero();
+    for (j = n + 1; j + 3 < cols; j += 4) {
+      strip.col(j).noalias() -= V(j, i) * t;
+      t0.noalias() += V(j, n) * strip.col(j);
+      strip.col(j + 1).noalias() -= V(j + 1, i) * t;
+      t1.noalias() += V(j + 1, n) * strip.col(j + 1);
+      strip.col(j + 2).noalias() -= V(j + 2, i) * t;
+      t2.noalias() += V(j + 2, n) * strip.col(j + 2);
+      strip.col(j + 3).noalias() -= V(j + 3, i) * t;
+      t3.noalias() += V(j + 3, n) * strip.col(j + 3);
+    }
+    for (; j < cols; ++j) {
+      strip.col(j).noalias() -= V(j, i) * t;
+      t0.noalias() += V(j, n) * strip.col(j);
+    }
+    i = n;
   }
 }
 
