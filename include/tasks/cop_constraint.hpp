@@ -40,6 +40,7 @@ class CopConstraint : public hqp::Constraint<4 * Layout::num_contacts, Layout::n
 
   template <class Dyn>
   void update(const Dyn& dyn, const References<NC>&) noexcept {
+    this->upper.setConstant(-moment_margin);
     for (int c = 0; c < NC; ++c) {
       const Eigen::Matrix3d R = contactSurfaceRotation<6>(dyn, c);
       // Sole axes in world coordinates: f_sz = n·f, m_sx = t_x·m, m_sy = t_y·m.
@@ -64,7 +65,6 @@ class CopConstraint : public hqp::Constraint<4 * Layout::num_contacts, Layout::n
     y_min = p.sole_y_min;
     y_max = p.sole_y_max;
     moment_margin = p.cop_moment_margin;
-    this->upper.setConstant(-moment_margin);
   }
 };
 
