@@ -184,6 +184,13 @@ class BalanceHierarchy : public ::testing::Test {
     }
   }
 
+  // The hip-strategy budget on: θ_max (rad), K (N·m/rad), D 10 /s.
+  void useHipBudget(double tilt, double K) {
+    params.hip_max_tilt = tilt;
+    params.hip_stiffness = K;
+    params.hip_damping = 10.0;
+  }
+
   VectorQ q;
   Dyn dyn;
   Refs refs;
@@ -551,9 +558,7 @@ TEST_F(BalanceHierarchy, HipStrategyBudgetBoundsTheAngularMomentumRate) {
   };
   const double K = 40.0, tilt = 0.5;
   hqp::tasks::BalanceParameters<Robot::nj> off = params;
-  params.hip_max_tilt = tilt;
-  params.hip_stiffness = K;
-  params.hip_damping = 10.0;
+  useHipBudget(tilt, K);
   ASSERT_EQ(angularMomentumRate(VectorX::Zero()).norm(), 0.0);
   Refs ahead = refs, aside = refs, tilted = refs;
   ahead.com.x() += 0.3;
@@ -588,9 +593,7 @@ TEST_F(BalanceHierarchy, HipStrategyBudgetBoundsTheAngularMomentumRate) {
 TEST_F(BalanceHierarchy, CopMomentMarginGrowsAsTheFootUnloads) {
   const double delta = 1.0;
   params.cop_moment_margin = delta;
-  params.hip_max_tilt = 0.5;  // the budget bounds the torso's share, so the CoPs must give all they can
-  params.hip_stiffness = 40.0;
-  params.hip_damping = 10.0;
+  useHipBudget(0.5, 40.0);  // the budget bounds the torso's share, so the CoPs must give all they can
   Refs ahead = refs, aside = refs;
   ahead.com.x() += 0.3;
   aside.com.y() += 0.3;
