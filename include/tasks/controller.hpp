@@ -120,6 +120,7 @@ class Controller {
       cop[c] = estimator_.cop(c);
       contact[c] = estimator_.inContact(c);
       support_acceleration[c] = estimator_.supportAcceleration(c);
+      refs_.contact_load[c] = estimator_.soleWrench(c)[2];
     }
     planner_.update(dyn_, cop, contact, refs_, &support_acceleration);
     stage(Stage::Planner);

@@ -10,6 +10,11 @@
 // stays δ / f_sz inside the rectangle, a margin that grows as the foot unloads. A joint-torque error
 // moves the true CoP by about δτ / f_sz, so a fixed distance from the edge protects a loaded foot
 // and not a light one; a fixed moment protects both. It implies f_sz ≥ 2δ / (y_max − y_min).
+// Each contact's δ is capped at (y_max − y_min) f_load / 4 (f_load: its measured normal force,
+// References::contact_load), so the rows never ask a foot for more than half the load it carries:
+// a foot the plant is lifting is let go instead of being held down.
+
+#include <algorithm>
 
 #include <Eigen/Core>
 
@@ -19,6 +24,11 @@
 #include "tasks/references.hpp"
 
 namespace hqp::tasks {
+
+// δ_c = min(δ, (y_max − y_min) f_load / 4): the moment margin of a foot that carries f_load.
+inline double copMomentMargin(double delta, double load, double y_min, double y_max) noexcept {
+  return std::min(delta, 0.25 * (y_max - y_min) * std::max(0.0, load));
+}
 
 template <class Layout>
 class CopConstraint : public hqp::Constraint<4 * Layout::num_contacts, Layout::nx> {
@@ -39,9 +49,9 @@ class CopConstraint : public hqp::Constraint<4 * Layout::num_contacts, Layout::n
   }
 
   template <class Dyn>
-  void update(const Dyn& dyn, const References<NC>&) noexcept {
-    this->upper.setConstant(-moment_margin);
+  void update(const Dyn& dyn, const References<NC>& refs) noexcept {
     for (int c = 0; c < NC; ++c) {
+      this->upper.template segment<4>(4 * c).setConstant(-copMomentMargin(moment_margin, refs.contact_load[c], y_min, y_max));
       const Eigen::Matrix3d R = contactSurfaceRotation<6>(dyn, c);
       // Sole axes in world coordinates: f_sz = n·f, m_sx = t_x·m, m_sy = t_y·m.
       const Eigen::RowVector3d tx = R.col(0).transpose(), ty = R.col(1).transpose(),

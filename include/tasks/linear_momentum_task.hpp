@@ -29,6 +29,7 @@
 #include "hqp/task.hpp"
 #include "model/data.hpp"
 #include "tasks/contact_layout.hpp"
+#include "tasks/cop_constraint.hpp"
 #include "tasks/orientation_error.hpp"
 #include "tasks/pd_gains.hpp"
 #include "tasks/references.hpp"
@@ -126,9 +127,12 @@ class LinearMomentumTask : public hqp::Task<3, Layout::nx> {
         hi = hi.cwiseMax(p);
       }
     }
-    // The CoP constraint's moment margin δ on every contact moves the whole robot's CoP range in
-    // by NC δ over the weight (the total normal force standing still).
-    const double shrink = NC * cop_moment_margin_ / (dyn.mass() * hqp::model::kGravity);
+    // The CoP constraint's moment margins δ_c move the whole robot's CoP range in by Σ δ_c over
+    // the weight (the total normal force standing still).
+    double margin = 0.0;
+    for (int c = 0; c < NC; ++c)
+      margin += copMomentMargin(cop_moment_margin_, refs.contact_load[c], cop_lo_.y(), cop_hi_.y());
+    const double shrink = margin / (dyn.mass() * hqp::model::kGravity);
     lo.array() += shrink;
     hi.array() -= shrink;
     const Eigen::Vector3d& c = dyn.com();

@@ -3,6 +3,7 @@
 // All quantities in world coordinates; wrenches [force; moment] about the contact origin.
 
 #include <array>
+#include <limits>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -25,6 +26,9 @@ struct References {
   Eigen::Vector3d torso_angular_velocity = Eigen::Vector3d::Zero();      // rad/s (world)
   Eigen::Vector3d torso_angular_acceleration = Eigen::Vector3d::Zero();  // feed-forward, rad/s²
   std::array<Vector6, NC> contact_force;               // F_ref = [f; m]; the first CD entries are used
+  // Measured normal force per contact (N, sole frame; ∞: unknown): caps the CoP moment margin so
+  // that a foot the plant is lifting is not held down.
+  std::array<double, NC> contact_load;
 
   References() {
     for (int c = 0; c < NC; ++c) {
@@ -32,6 +36,7 @@ struct References {
       contact_velocity[c].setZero();
       contact_acceleration[c].setZero();
       contact_force[c].setZero();
+      contact_load[c] = std::numeric_limits<double>::infinity();
     }
   }
 };

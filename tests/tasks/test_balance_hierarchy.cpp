@@ -15,9 +15,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <new>
 
 #include <Eigen/LU>
@@ -167,7 +169,8 @@ class BalanceHierarchy : public ::testing::Test {
   }
 
   // The bounds of every contact constraint at x, checked on the sole-frame wrenches.
-  void expectContactConstraints(const VectorX& x, double tol) const {
+  // `margin`: each foot's moment margin δ_c (default: the parameter's δ on both).
+  void expectContactConstraints(const VectorX& x, double tol, std::array<double, 2> margin = {-1.0, -1.0}) const {
     const double k = params.mu / std::sqrt(2.0);
     for (int c = 0; c < 2; ++c) {
       const auto w = soleWrench(dyn, x, c);
@@ -175,8 +178,9 @@ class BalanceHierarchy : public ::testing::Test {
       EXPECT_GE(fz, params.fz_min - tol) << "foot " << c;
       EXPECT_LE(std::abs(w(0)), k * fz + tol) << "foot " << c;
       EXPECT_LE(std::abs(w(1)), k * fz + tol) << "foot " << c;
-      // The CoP keeps δ / f_z from the region's edges (δ = the moment margin, 0 by default).
-      const double cop_x = -w(4) / fz, cop_y = w(3) / fz, inset = params.cop_moment_margin / fz;
+      // The CoP keeps δ_c / f_z from the region's edges (δ = the moment margin, 0 by default).
+      const double delta = margin[c] >= 0.0 ? margin[c] : params.cop_moment_margin;
+      const double cop_x = -w(4) / fz, cop_y = w(3) / fz, inset = delta / fz;
       EXPECT_GE(cop_x, params.sole_x_min + inset - tol) << "foot " << c;
       EXPECT_LE(cop_x, params.sole_x_max - inset + tol) << "foot " << c;
       EXPECT_GE(cop_y, params.sole_y_min + inset - tol) << "foot " << c;
@@ -614,7 +618,23 @@ TEST_F(BalanceHierarchy, CopMomentMarginGrowsAsTheFootUnloads) {
   for (const auto& w : {wl, wr}) {  // both on the bound towards −y, the lighter one further in
     EXPECT_NEAR(w(3) / w(2), params.sole_y_min + delta / w(2), 1e-9);
   }
+  // The lighter foot measured at 12 N: its margin is capped at (y_max − y_min)·12 N / 4, which
+  // asks it for at most 6 N, so fz_min alone holds it down and its CoP moves out to the cap's inset.
+  const int light = wl(2) < wr(2) ? 0 : 1;
+  const double cap = 0.25 * (params.sole_y_max - params.sole_y_min) * 12.0;
+  ASSERT_LT(cap, delta);
+  aside.contact_load[light] = 12.0;
+  ASSERT_EQ(solve(wbc, aside), hqp::QpStatus::Optimal);
+  std::array<double, 2> margins{delta, delta};
+  margins[light] = cap;
+  expectContactConstraints(wbc.x(), 1e-9, margins);
+  const auto wc = soleWrench(dyn, wbc.x(), light);
+  EXPECT_LT(wc(2), light_load - 1.0);  // let go: it carries less than with the full margin
+  EXPECT_NEAR(wc(3) / wc(2), params.sole_y_min + cap / wc(2), 1e-9);
+  const auto wh = soleWrench(dyn, wbc.x(), 1 - light);
+  EXPECT_NEAR(wh(3) / wh(2), params.sole_y_min + delta / wh(2), 1e-9);
   // The same demand without the margin puts both CoPs on the region's edge.
+  aside.contact_load[light] = std::numeric_limits<double>::infinity();
   params.cop_moment_margin = 0.0;
   ASSERT_EQ(solve(wbc, aside), hqp::QpStatus::Optimal);
   for (int c = 0; c < 2; ++c) {
