@@ -105,7 +105,7 @@ TEST(ControllerConfig, ShippedFileLoads) {
   EXPECT_EQ(c.balance.hip_max_tilt, 0.7);
   EXPECT_EQ(c.balance.hip_stiffness, 100.0);
   EXPECT_EQ(c.balance.hip_damping, 10.0);
-  EXPECT_EQ(c.balance.cop_moment_margin, 0.0);  // optional, off for Walker3
+  EXPECT_EQ(c.balance.cop_moment_margin, 1.0);
   EXPECT_TRUE(c.planner.hold_tipping_axis);
   EXPECT_EQ(c.balance.com_vertical.kp, 9.0);
   EXPECT_EQ(c.balance.com_vertical.kd, 6.0);
@@ -175,7 +175,7 @@ TEST(ControllerConfig, NegativeOrInvalidValuesAreRejected) {
   expectRejected("com:          {kp: 4, kd: 3}", "com:          {kp: -4, kd: 3}", "balance.com.kp");
   expectRejected("reset_on_crossing: true", "reset_on_crossing: 1.5", "balance.com_integral.reset_on_crossing");
   expectRejected("  torso_error_limit: 0.2", "  torso_error_limit: 0", "balance.torso_error_limit");
-  expectRejected("  torso_weight: 1.0", "  cop_moment_margin: -0.1\n  torso_weight: 1.0", "balance.cop_moment_margin");
+  expectRejected("  cop_moment_margin: 1.0", "  cop_moment_margin: -0.1", "balance.cop_moment_margin");
   expectRejected("{max_tilt: 0.7,", "{max_tilt: 0,", "balance.hip_strategy.max_tilt");
   expectRejected("stiffness: 100, damping: 10}", "stiffness: 100, damping: -1}", "balance.hip_strategy.damping");
   expectRejected("stiffness: 100, damping: 10}", "stiffness: 100}", "balance.hip_strategy.damping");
@@ -193,7 +193,7 @@ TEST(ControllerConfig, NegativeOrInvalidValuesAreRejected) {
   expectRejected("  dt: 0.001", "  dt: 0", "controller.dt");
   expectRejected("  solver: hqp", "  solver: lqp", "controller.solver");
   expectRejected("    l_knee:         250", "    l_knee:         300", "balance.torque_limit.l_knee");
-  expectRejected("x_min: -0.10, x_max: 0.10", "x_min: 0.10, x_max: -0.10", "balance.cop_region");
+  expectRejected("x_min: -0.105, x_max: 0.105", "x_min: 0.105, x_max: -0.105", "balance.cop_region");
   expectRejected("  mu: 0.6", "  mu: .nan", "balance.mu");
   expectRejected("  follow_acceleration_cutoff: 20", "  follow_acceleration_cutoff: -1",
                  "planner.follow_acceleration_cutoff");
@@ -260,9 +260,9 @@ TEST(ControllerConfig, MovingSupportOptionsDefaultToThePaperRule) {
   ASSERT_TRUE(m.found());
   EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(m.path()).balance.hip_max_tilt,
             std::numeric_limits<double>::infinity());
-  EditedConfig r("  torso_weight: 1.0", "  cop_moment_margin: 1.5\n  torso_weight: 1.0");  // switched on
+  EditedConfig r("  cop_moment_margin: 1.0", "  # cop_moment_margin: 1.0");  // optional: off
   ASSERT_TRUE(r.found());
-  EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(r.path()).balance.cop_moment_margin, 1.5);
+  EXPECT_EQ(hqp::tasks::loadControllerConfig<Robot>(r.path()).balance.cop_moment_margin, 0.0);
 }
 
 TEST(ControllerConfig, OtherSolverAndInfiniteLeakLoad) {
