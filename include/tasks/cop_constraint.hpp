@@ -25,7 +25,8 @@
 
 namespace hqp::tasks {
 
-// δ_c = min(δ, (y_max − y_min) f_load / 4): the moment margin of a foot that carries f_load.
+// δ_c = min(δ, (y_max − y_min) f_load / 4): the moment margin of a foot that carries f_load
+// (0 for a load ≤ 0 or NaN).
 inline double copMomentMargin(double delta, double load, double y_min, double y_max) noexcept {
   return std::min(delta, 0.25 * (y_max - y_min) * std::max(0.0, load));
 }
@@ -51,7 +52,8 @@ class CopConstraint : public hqp::Constraint<4 * Layout::num_contacts, Layout::n
   template <class Dyn>
   void update(const Dyn& dyn, const References<NC>& refs) noexcept {
     for (int c = 0; c < NC; ++c) {
-      this->upper.template segment<4>(4 * c).setConstant(-copMomentMargin(moment_margin, refs.contact_load[c], y_min, y_max));
+      const double margin = copMomentMargin(moment_margin, refs.contact_load[c], y_min, y_max);
+      this->upper.template segment<4>(4 * c).setConstant(-margin);
       const Eigen::Matrix3d R = contactSurfaceRotation<6>(dyn, c);
       // Sole axes in world coordinates: f_sz = n·f, m_sx = t_x·m, m_sy = t_y·m.
       const Eigen::RowVector3d tx = R.col(0).transpose(), ty = R.col(1).transpose(),

@@ -26,8 +26,9 @@ struct References {
   Eigen::Vector3d torso_angular_velocity = Eigen::Vector3d::Zero();      // rad/s (world)
   Eigen::Vector3d torso_angular_acceleration = Eigen::Vector3d::Zero();  // feed-forward, rad/s²
   std::array<Vector6, NC> contact_force;               // F_ref = [f; m]; the first CD entries are used
-  // Measured normal force per contact (N, sole frame; ∞: unknown): caps the CoP moment margin so
-  // that a foot the plant is lifting is not held down.
+  // Measured normal force per contact (N, sole frame; ∞: unknown), written by the controller from
+  // the F/T wrench, not by the planner: caps the CoP moment margin so that a foot the plant is
+  // lifting is not held down.
   std::array<double, NC> contact_load;
 
   References() {
