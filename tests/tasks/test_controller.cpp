@@ -4,6 +4,7 @@
 #define EIGEN_RUNTIME_NO_MALLOC
 #include <gtest/gtest.h>
 
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -18,6 +19,7 @@
 #include <unistd.h>
 
 #include "model/rnea.hpp"
+#include "tasks/cop_constraint.hpp"
 #include "support/walker3_controller.hpp"
 #include "support/walker3_standing.hpp"
 #include "support/allocation_counter.hpp"
@@ -98,6 +100,39 @@ TEST_P(ControllerStanding, TorquesAreGravityCompensationAndZmpAtSoleCentre) {
     }
     EXPECT_LE(levels_us, d.time_us[static_cast<int>(hqp::tasks::Stage::Solve)]);
   }
+}
+
+// The CoP rows' moment margin is capped by each foot's measured load (docs/tasks.md, "CoP moment
+// margin"): the tick hands the F/T normal forces to the references, and the rows of a foot that
+// carries f_z get the bound −min(δ, (y_max − y_min) f_z / 4).
+TEST(ControllerCopMargin, MeasuredLoadsCapTheMomentMargin) {
+  const auto s = hqp::testing::walker3Standing();
+  const double weight = Robot::total_mass * kG, light = 20.0;
+  const std::array<double, 2> load{weight - light, light};
+  const auto sensors =
+      hqp::testing::walker3RestingSensors(s, load, {Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()});
+  const auto cfg = walker3Config(Controller::Config::Solver::Hqp, s.com_height);
+  const double delta = cfg.balance.cop_moment_margin;
+  ASSERT_GT(delta, 0.0) << "the shipped Walker3 configuration has the margin on";
+  const double capped = 0.25 * (cfg.balance.sole_y_max - cfg.balance.sole_y_min) * light;
+  ASSERT_LT(capped, delta);
+  const double expected[2] = {delta, capped};
+  auto ctrl = makeWalker3Controller(cfg);
+  Controller::Command cmd;
+  for (int k = 0; k < 3; ++k) ctrl->tick(sensors, cmd);
+  ASSERT_EQ(ctrl->diagnostics().mode, ControllerMode::Balance) << toString(ctrl->diagnostics().reason);
+  for (int c = 0; c < 2; ++c) EXPECT_NEAR(ctrl->references().contact_load[c], load[c], 1e-9) << "foot " << c;
+  // Both solvers hold a CoP constraint; only the ticked one (HqpWbc) was updated.
+  int seen = 0, capped_rows = 0;
+  ctrl->configureItems<hqp::tasks::CopConstraint<Layout>>([&](const auto& cop) {
+    ++seen;
+    int rows = 0;
+    for (int c = 0; c < 2; ++c)
+      for (int r = 0; r < 4; ++r) rows += std::abs(cop.upper(4 * c + r) + expected[c]) < 1e-12;
+    if (rows > 0) capped_rows = rows;
+  });
+  EXPECT_EQ(seen, 2);
+  EXPECT_EQ(capped_rows, 8);
 }
 
 INSTANTIATE_TEST_SUITE_P(Solvers, ControllerStanding,
