@@ -64,6 +64,13 @@ struct HqpSettings {
   // default: a check for tests and diagnostics, not needed to use the answer. The multipliers
   // themselves are always reported (they are a copy).
   bool kkt_residuals = false;
+  // Constraints deferred to the last level (docs/hqp.md, "Deferred constraints"): every level
+  // above the last takes its unconstrained least-squares step without looking at a constraint,
+  // and the last level's QP holds every constraint row. If that QP ends Optimal, each higher
+  // level sits at its unconstrained minimum at a point meeting all rows, so x is the
+  // lexicographic optimum; otherwise the cascade runs from the start (the attempt's work is
+  // lost). Not tried with a budget (budget_us, budget_iterations).
+  bool defer_constraints = true;
 };
 
 // KKT residuals of one level's QP (docs/hqp.md, "Certificate"), in its variables u (x = x*_{p−1}
@@ -122,6 +129,9 @@ struct HqpResult {
   // First level cut by the budget (HqpSettings::budget_us / budget_iterations), −1 if none.
   // If no higher level failed, status is then QpStatus::BudgetCut and failed_level == cut_level.
   int cut_level = -1;
+  // The solve took the deferred path (HqpSettings::defer_constraints): the levels above the
+  // last report no QP and no active row, the last level holds every constraint row.
+  bool deferred = false;
   std::array<HqpLevelResult<MaxActive>, NumLevels> levels{};
 };
 
@@ -230,6 +240,7 @@ class HqpWbc {
   void setDualLastLevel(bool on) { settings_.dual_last_level = on; }
   void setLevelTiming(bool on) { settings_.time_levels = on; }    // HqpSettings::time_levels
   void setKktResiduals(bool on) { settings_.kkt_residuals = on; }  // HqpSettings::kkt_residuals
+  void setDeferConstraints(bool on) { settings_.defer_constraints = on; }
   // Per-solve budget (HqpSettings::budget_us / budget_iterations; ≤ 0 = none).
   void setBudget(double us, int iterations) {
     settings_.budget_us = us;
@@ -251,22 +262,11 @@ class HqpWbc {
     iterations_used_ = 0;
     result_.cut_level = -1;
     stackAll(std::make_index_sequence<sizeof...(Levels)>{});
-    result_.status = QpStatus::Optimal;
-    result_.failed_level = -1;
-    x_.setZero();
-    n_ = Nx;
     if constexpr (total_constraint_rows > 0)
       Dnorm_.head(total_constraint_rows) = D_.topRows(total_constraint_rows).rowwise().norm();
-    // Working copy of all rows in the reduced coordinates of the current level (Z_{−1} = I),
-    // and the reduced right-hand sides b − A x*, D x* (x*_{−1} = 0).
-    W_.template topRows<total_task_rows>() = A_.template topRows<total_task_rows>();
-    if constexpr (total_constraint_rows > 0) {
-      W_.template middleRows<total_constraint_rows>(total_task_rows) =
-          D_.template topRows<total_constraint_rows>();
-      dx_.setZero();
-    }
-    bt_ = b_;
+    begin();
     result_.higher_level_degraded = false;
+    result_.deferred = false;
     if (!inputValid()) {
       for (auto& lr : result_.levels) lr = HqpLevelResult<max_active>{};
       result_.status = QpStatus::InvalidInput;
@@ -275,7 +275,17 @@ class HqpWbc {
       result_.x = x_;
       return result_.status;
     }
-    solveLevels(std::make_index_sequence<sizeof...(Levels)>{});
+    if (deferAllowed()) {
+      deferred_ = true;
+      aborted_ = false;
+      solveLevels(std::make_index_sequence<sizeof...(Levels)>{});
+      deferred_ = false;
+      result_.deferred = !aborted_;
+      if (aborted_) begin();  // the cascade from the start
+      else resetHigherWorkingSets(std::make_index_sequence<sizeof...(Levels) - 1>{});
+      aborted_ = false;
+    }
+    if (!result_.deferred) solveLevels(std::make_index_sequence<sizeof...(Levels)>{});
     reconstructX(num_levels);
     // Never a non-finite x: fall back to the last finite x*_p of the higher levels (or 0),
     // with a non-optimal status at the first level left out.
@@ -425,6 +435,40 @@ class HqpWbc {
     }
   }
 
+  // The state before level 0: Z_{−1} = I, x*_{−1} = 0.
+  void begin() {
+    result_.status = QpStatus::Optimal;
+    result_.failed_level = -1;
+    x_.setZero();
+    n_ = Nx;
+    // Working copy of all rows in the reduced coordinates of the current level (Z_{−1} = I),
+    // and the reduced right-hand sides b − A x*, D x* (x*_{−1} = 0).
+    W_.template topRows<total_task_rows>() = A_.template topRows<total_task_rows>();
+    if constexpr (total_constraint_rows > 0) {
+      W_.template middleRows<total_constraint_rows>(total_task_rows) =
+          D_.template topRows<total_constraint_rows>();
+      dx_.setZero();
+    }
+    bt_ = b_;
+  }
+
+  // HqpSettings::defer_constraints: worth trying only where some constraint row would be
+  // checked above the last level.
+  bool deferAllowed() const {
+    return num_levels > 1 && constraint_offset[num_levels - 1] > 0 &&
+           settings_.defer_constraints && !(settings_.budget_us > 0.0) &&
+           settings_.budget_iterations <= 0;
+  }
+  // After a deferred solve the levels above the last ran no QP: their working sets are empty,
+  // as after a free step, so the warm state stays the working sets alone.
+  template <std::size_t... I>
+  void resetHigherWorkingSets(std::index_sequence<I...>) {
+    (resetQp(std::get<I>(qps_)), ...);
+  }
+  // Rows from here on are the level's own (bounds not widened to contain 0, locked rows
+  // checked): c0, or 0 on the deferred path, whose x*_{p−1} was never checked against a row.
+  int ownBegin(int c0) const { return deferred_ ? 0 : c0; }
+
   template <std::size_t... I>
   void solveLevels(std::index_sequence<I...>) {
     (timedLevel<static_cast<int>(I)>(), ...);
@@ -436,6 +480,7 @@ class HqpWbc {
   void timedLevel() {
     const bool timed = kLevelTiming && settings_.time_levels;
     const bool clock = timed || settings_.budget_us > 0.0;
+    if (aborted_) return;  // the deferred path failed: the cascade starts over
     std::chrono::steady_clock::time_point start{};
     if (clock) start = std::chrono::steady_clock::now();
     if (result_.cut_level < 0 && P > 0 && overBudget(P, start)) {
@@ -534,6 +579,10 @@ class HqpWbc {
     unrotated_[P] = false;
 
     if (n == 0) {
+      if (deferred_) {  // rows would have to be checked here: left to the cascade
+        aborted_ = true;
+        return;
+      }
       // Nothing left to move: only check the level's own constraints at x*.
       if constexpr (own > 0) ownRowsWithoutFreedom<P>(lr);
       lr.kkt.computed = settings_.kkt_residuals;  // no variables: stationarity is empty
@@ -550,6 +599,7 @@ class HqpWbc {
                                        .maxCoeff());
     if constexpr (P + 1 == num_levels && c > 0 && !std::is_same_v<DualQp, detail::NoQp>) {
       if (settings_.dual_last_level && r >= n && dualLastLevel<P>(n, col0, scale, lr)) return;
+      if (aborted_) return;  // the deferred path's QP failed: no second try here
     }
     auto& ns = ns_[P];
     ns.compute(M_, settings_.rank_tol * scale);
@@ -583,6 +633,15 @@ class HqpWbc {
       }
       lr.status = QpStatus::Optimal;
       if (settings_.kkt_residuals) kktStationarity(lr, Aq_, bq_, u_, Aq_);  // no active row
+    } else if (!last && deferred_) {
+      // Deferred path: the unconstrained minimum-norm step; the last level checks every row.
+      if (!unconstrainedStep<P>(k)) {
+        aborted_ = true;
+        return;
+      }
+      u_.head(k) = ys_.head(k);
+      lr.status = QpStatus::Optimal;
+      if (settings_.kkt_residuals) kktStationarity(lr, Aq_, bq_, u_, Aq_);  // no active row
     } else if (std::get<P>(qps_).numActive() == 0 && freeStep<P>(n, k, col0, rotated)) {
       // The unconstrained minimum-norm step meets every row: it is the QP's optimum with
       // an empty working set, so the QP (and the last level's rotation) is skipped. It is
@@ -607,11 +666,15 @@ class HqpWbc {
       qp.upper() = upper_.head(c) - dx_.head(c);
       typename std::remove_reference_t<decltype(qp)>::VectorX hint;
       hint.setZero(n);  // x*_{p−1} meets every higher constraint: u = 0 is feasible for them
-      const bool locked_infeasible = neutralizeLockedRows(qp, c, c0);
+      const bool locked_infeasible = neutralizeLockedRows(qp, c, ownBegin(c0));
       QpStatus s = QpStatus::Infeasible;
       if (!locked_infeasible) {
-        s = qp.solve(hint, settings_.warm_start);
+        s = qp.solve(hint, settings_.warm_start);  // the hint is used only if feasible
         lr.iterations = qp.iterations();
+      }
+      if (deferred_ && s != QpStatus::Optimal) {  // some level above is not at its minimum
+        aborted_ = true;
+        return;
       }
       if constexpr (own > 0) {
         if (s == QpStatus::Infeasible) {
@@ -701,16 +764,22 @@ class HqpWbc {
     bq_.array() *= w_.template segment<r>(t0).array().sqrt();
     const double min_sigma = std::sqrt(static_cast<double>(r)) * settings_.rank_tol * scale;
     if (!dual_.factorize(M_, bq_, r, n, min_sigma)) return false;
+    // Past the rank test the general path would pose the same strictly convex QP: on the
+    // deferred path a failure below means a row holds some higher level away from its minimum
+    // (the cascade decides), not a reason to try the QP again.
+    aborted_ = deferred_;
     const auto Cw = W_.block(total_task_rows, col0, c, n);
     cnorm_.head(c) = Cw.rowwise().squaredNorm();
+    const int own_begin = ownBegin(c0);
     for (int i = 0; i < c; ++i) {
       double lo = lower_(i) - dx_(i), up = upper_(i) - dx_(i);
       // An own row with an empty interval: infeasible, the general path applies the policy.
-      if (i >= c0 && (lower_(i) - upper_(i)) / rowScale(Dnorm_(i)) > settings_.qp.feasibility_tol)
+      if (i >= own_begin &&
+          (lower_(i) - upper_(i)) / rowScale(Dnorm_(i)) > settings_.qp.feasibility_tol)
         return false;
-      widenHigherRow(i, c0, lo, up);
+      widenHigherRow(i, own_begin, lo, up);
       if (lockedRow(i, cnorm_(i))) {
-        if (i >= c0 && !lockedRowHolds(i, lo, up)) return false;
+        if (i >= own_begin && !lockedRowHolds(i, lo, up)) return false;
         lo = -kInf;
         up = kInf;
       }
@@ -723,6 +792,7 @@ class HqpWbc {
     if (dual_.solve(Cw, dlo_, dup_, c, settings_.qp, prefer_.data(), prefer) != QpStatus::Optimal)
       return false;
     u_ = dual_.x();
+    aborted_ = false;
     lr.status = QpStatus::Optimal;
     lr.dual = true;
     lr.iterations = dual_.iterations();
@@ -805,6 +875,8 @@ class HqpWbc {
   }
 
   // The last level's rows at the final x (= x*_p of the last level; dx_ is not updated there).
+  // On the deferred path the levels above are checked there too: their x*_p met no row, the
+  // final x (the same residuals, every row held) is their certified optimum.
   void lastLevelPrimal() {
     constexpr int c = total_constraint_rows;
     auto& lr = result_.levels[static_cast<std::size_t>(num_levels - 1)];
@@ -812,6 +884,10 @@ class HqpWbc {
       if (!lr.kkt.computed) return;
       kkt_d_.template head<c>().noalias() = D_.template topRows<c>() * x_;
       kktRows(lr, c, kkt_d_);
+      for (int p = 0; result_.deferred && p + 1 < num_levels; ++p) {
+        auto& lp = result_.levels[static_cast<std::size_t>(p)];
+        if (lp.kkt.computed) kktRows(lp, constraint_offset[static_cast<std::size_t>(p) + 1], kkt_d_);
+      }
     }
   }
 
@@ -823,20 +899,10 @@ class HqpWbc {
   // u_ and returns true, or returns false (u_ untouched) and the QP decides.
   template <int P>
   bool freeStep(int n, int k, int col0, bool rotated) {
-    constexpr int r = LevelType<P>::task_rows;
     constexpr int c0 = constraint_offset[P];
     constexpr int c = constraint_offset[P + 1];
     constexpr int rows0 = total_task_rows;  // first constraint row in W_
-    if (k == r) {
-      // Â_p Q₁ = Π R₁ᵀ is square: forward substitution, row Π(l) gives y_l (NullSpace).
-      const auto& R = ns_[P].matrixQR();
-      for (int l = 0; l < k; ++l)
-        ys_(l) = (bq_(ns_[P].permutation(l)) - R.col(l).head(l).dot(ys_.head(l))) / R(l, l);
-    } else if (k > 0) {
-      Ls_ = Aq_.leftCols(k);
-      bs_ = bq_;
-      if (detail::qpMinNormLeastSquares(Ls_, r, k, bs_, ys_, 0.0, ls_ws_) != k) return false;
-    }
+    if (!unconstrainedStep<P>(k)) return false;
     // Constraint rows times u': rotated rows see [y; 0]; unrotated ones Q [y; 0].
     auto Cw = W_.block(rows0, col0, c, n);
     if (rotated) {
@@ -851,7 +917,7 @@ class HqpWbc {
     const double tol2 = settings_.qp.feasibility_tol * settings_.qp.feasibility_tol;
     for (int i = 0; i < c; ++i) {
       double lo = lower_(i) - dx_(i), up = upper_(i) - dx_(i);
-      widenHigherRow(i, c0, lo, up);
+      widenHigherRow(i, ownBegin(c0), lo, up);
       const double v = tmp_(i);
       const double viol = std::max(lo - v, v - up);
       // The row's norm only where a bound is crossed (most rows are strictly inside).
@@ -860,6 +926,24 @@ class HqpWbc {
     u_.setZero(n);
     u_.head(k) = ys_.head(k);
     return true;
+  }
+
+  // ys_(0:k) = argmin ‖L y − b'‖, L = Â_p Q₁ of full column rank k (NullSpace): the row-space
+  // part of the level's unconstrained minimum-norm step. False if the solve failed.
+  template <int P>
+  bool unconstrainedStep(int k) {
+    constexpr int r = LevelType<P>::task_rows;
+    if (k == r) {
+      // Â_p Q₁ = Π R₁ᵀ is square: forward substitution, row Π(l) gives y_l (NullSpace).
+      const auto& R = ns_[P].matrixQR();
+      for (int l = 0; l < k; ++l)
+        ys_(l) = (bq_(ns_[P].permutation(l)) - R.col(l).head(l).dot(ys_.head(l))) / R(l, l);
+    } else if (k > 0) {
+      Ls_ = Aq_.leftCols(k);
+      bs_ = bq_;
+      if (detail::qpMinNormLeastSquares(Ls_, r, k, bs_, ys_, 0.0, ls_ws_) != k) return false;
+    }
+    return std::isfinite(ys_.head(k).sum());
   }
 
   // Higher rows: their shifted bounds are widened to contain 0 (see below).
@@ -1043,6 +1127,8 @@ class HqpWbc {
   Eigen::Matrix<double, Nx, 1> ys_ = Eigen::Matrix<double, Nx, 1>::Zero();  // its solution
   detail::QpMinNormWorkspace<capacity(max_task_rows), Nx> ls_ws_;
   Result result_{};
+  bool deferred_ = false;  // solving on the deferred path (HqpSettings::defer_constraints)
+  bool aborted_ = false;   // the deferred path failed; the cascade runs
   VectorM kkt_e_;                // certificate scratch: A u − b
   VectorU kkt_s_;                // its stationarity vector
   VectorC kkt_d_ = VectorC::Zero();  // D x at the last level

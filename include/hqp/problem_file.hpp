@@ -40,7 +40,7 @@ struct ProblemFileInfo {
 namespace problem_file {
 
 inline constexpr char kMagic[8] = {'H', 'Q', 'P', 'P', 'R', 'O', 'B', '\n'};
-inline constexpr std::uint32_t kVersion = 2;  // 2: + HqpSettings::dual_last_level
+inline constexpr std::uint32_t kVersion = 3;  // 2: + dual_last_level, 3: + defer_constraints
 
 // Bytes of one instance for a shape (docs/recording.md, "Record").
 inline std::uint64_t recordBytes(int nx, int levels, int task_rows, int constraint_rows) {
@@ -165,8 +165,8 @@ inline ProblemFileInfo decodeHeader(Reader& r) {
   if (std::memcmp(magic.data(), kMagic, 8) != 0)
     r.fail("wrong magic number: not an HQP problem recording (docs/recording.md)");
   info.version = r.u32("the version");
-  if (info.version != kVersion && info.version != 1)
-    r.fail("unsupported version " + std::to_string(info.version) + " (this build reads versions 1 and " +
+  if (info.version < 1 || info.version > kVersion)
+    r.fail("unsupported version " + std::to_string(info.version) + " (this build reads versions 1 to " +
            std::to_string(kVersion) + ")");
   info.nx = r.i32("nx");
   const int levels = r.i32("the number of levels");
@@ -189,6 +189,8 @@ inline ProblemFileInfo decodeHeader(Reader& r) {
   info.settings.warm_start = r.i32("settings.warm_start") != 0;
   // Version 1 files were recorded before the dual method existed.
   info.settings.dual_last_level = info.version >= 2 && r.i32("settings.dual_last_level") != 0;
+  // Versions 1 and 2 were recorded before the deferred path existed (the cascade solved them).
+  info.settings.defer_constraints = info.version >= 3 && r.i32("settings.defer_constraints") != 0;
   info.settings.qp.max_iterations = r.i32("settings.qp.max_iterations");
   info.settings.qp.feasibility_tol = r.f64("settings.qp.feasibility_tol");
   info.settings.qp.rank_tol = r.f64("settings.qp.rank_tol");
@@ -238,6 +240,7 @@ std::string encodeProblemFile(const ProblemInstance<Wbc>* instances, std::size_t
   w.f64(settings.rank_tol);
   w.i32(settings.warm_start ? 1 : 0);
   w.i32(settings.dual_last_level ? 1 : 0);
+  w.i32(settings.defer_constraints ? 1 : 0);
   w.i32(settings.qp.max_iterations);
   w.f64(settings.qp.feasibility_tol);
   w.f64(settings.qp.rank_tol);

@@ -399,13 +399,14 @@ ControllerConfig<Robot::nj> loadControllerConfig(const std::string& path) {
       const std::string p = "qp.hqp";
       const YAML::Node m = r.map(n, "qp", "hqp",
                                  {"max_iterations", "feasibility_tol", "rank_tol", "dual_tol", "max_magnitude",
-                                  "level_rank_tol", "warm_start", "dual_last_level", "residual_rise_tol",
-                                  "budget_us", "budget_iterations", "time_levels"});
+                                  "level_rank_tol", "warm_start", "dual_last_level", "defer_constraints",
+                                  "residual_rise_tol", "budget_us", "budget_iterations", "time_levels"});
       HqpSettings& h = c.qp.hqp;
       qpKeys(m, p, h.qp);
       if (m["level_rank_tol"]) h.rank_tol = r.tolerance(m, p, "level_rank_tol");
       if (m["warm_start"]) h.warm_start = r.boolean(m, p, "warm_start");
       if (m["dual_last_level"]) h.dual_last_level = r.boolean(m, p, "dual_last_level");
+      if (m["defer_constraints"]) h.defer_constraints = r.boolean(m, p, "defer_constraints");
       if (m["residual_rise_tol"]) h.residual_rise_tol = r.tolerance(m, p, "residual_rise_tol");
       // Per-tick budget of the solve; 0 = none (HqpSettings::budget_us / budget_iterations).
       if (m["budget_us"]) h.budget_us = r.atLeast(m, p, "budget_us", 0.0, false);

@@ -41,9 +41,10 @@ double unif(std::mt19937& g, double a, double b) {
 
 // kind 0: generic; 1: rank-deficient tasks; 2: tasks conflicting across levels;
 // 3: a constraint of level 2 contradicting level 1's task (infeasible level, dropped).
-std::vector<hqp::testing::RefLevel> makeLevels(int kind, std::mt19937& g) {
+std::vector<hqp::testing::RefLevel> makeLevels(int kind, std::mt19937& g, Eigen::VectorXd* inside = nullptr) {
   std::vector<hqp::testing::RefLevel> L(4);
   const Eigen::VectorXd x0 = randn(N, 1, g);  // feasible for every constraint
+  if (inside != nullptr) *inside = x0;
   for (int p = 0; p < 4; ++p) {
     auto& l = L[static_cast<size_t>(p)];
     l.A = randn(kTaskRows[p], N, g);
@@ -182,6 +183,87 @@ INSTANTIATE_TEST_SUITE_P(HqpInequality, HqpInequalityLastLevel, ::testing::Value
                          [](const ::testing::TestParamInfo<bool>& i) {
                            return i.param ? std::string("DualMethod") : std::string("ActiveSetQp");
                          });
+
+// The deferred path (HqpSettings::defer_constraints, docs/hqp.md "Deferred constraints"): the
+// levels above the last take their unconstrained steps, the last level holds every row, and
+// the cascade runs only if that fails. Half the trials move levels 1–3's targets onto the point
+// every row holds (their unconstrained minima are then reachable: the deferred path must
+// hold), half keep the far targets (mostly the cascade). Either way: the brute-force cascade's
+// per-level residuals, the same x as with the path off (where it ends alike), every kept row
+// held, and on the deferred path a certificate checked here, not by the solver.
+TEST(HqpInequality, DeferredPathGivesTheCascadesOptimum) {
+  std::mt19937 g(47);
+  static Wbc on, off;
+  off.setDeferConstraints(false);
+  on.setKktResiduals(true);
+  int deferred = 0, cascade = 0, deferred_active = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    Eigen::VectorXd x0;
+    auto L = makeLevels(trial % 4, g, &x0);
+    const bool reachable = trial % 2 == 0;  // kinds 0 and 2
+    if (reachable)
+      for (int p = 0; p < 3; ++p) L[static_cast<size_t>(p)].b = L[static_cast<size_t>(p)].A * x0;
+    const auto ref = hqp::testing::bruteForceCascade(L, N);
+    fill(on, L);
+    fill(off, L);
+    const hqp::QpStatus s = on.solve();
+    const hqp::QpStatus s_off = off.solve();
+    // The same status, or the deferred path found the optimum (its certificate is checked
+    // below) where the cascade stopped short.
+    EXPECT_TRUE(s == s_off || (on.result().deferred && s == hqp::QpStatus::Optimal)) << "trial " << trial;
+    const auto& r = on.result();
+    ASSERT_TRUE(r.x.allFinite());
+    EXPECT_FALSE(off.result().deferred);
+    if (reachable) EXPECT_TRUE(r.deferred) << "trial " << trial;
+    (r.deferred ? deferred : cascade) += 1;
+    std::vector<bool> dropped(4);
+    for (int p = 0; p < 4; ++p) {
+      const auto& lr = r.levels[static_cast<size_t>(p)];
+      const double res = ref.residual[static_cast<size_t>(p)];
+      EXPECT_NEAR(lr.residual, res, 1e-8 * (1.0 + res)) << "trial " << trial << " level " << p;
+      dropped[static_cast<size_t>(p)] = lr.constraints_dropped;
+    }
+    EXPECT_LT(maxViolation(L, r.x, dropped), 1e-8) << "trial " << trial;
+    const double xs = std::max(1.0, off.result().x.lpNorm<Eigen::Infinity>());
+    if (s_off == s) EXPECT_LT((r.x - off.result().x).lpNorm<Eigen::Infinity>() / xs, 1e-8) << "trial " << trial;
+    if (!r.deferred) continue;
+    EXPECT_EQ(s, hqp::QpStatus::Optimal);
+    for (int p = 0; p < 3; ++p) {
+      // Above the last level: no QP, no active row; the higher tasks at their unconstrained
+      // minimum (0 here: full row rank); the rows of levels ≤ p held at the final x.
+      const auto& lr = r.levels[static_cast<size_t>(p)];
+      EXPECT_EQ(lr.num_active, 0);
+      EXPECT_EQ(lr.iterations, 0);
+      if (reachable) EXPECT_LT(lr.residual, 1e-16 * (1.0 + L[static_cast<size_t>(p)].b.squaredNorm()));
+      EXPECT_TRUE(lr.kkt.computed);
+      EXPECT_LE(lr.kkt.primal, 1e-8) << "trial " << trial << " level " << p;
+    }
+    // The last level holds the rows of every level: its multipliers prove its optimum,
+    // x_L ∝ A₄ᵀ(A₄x − b₄) + Σ λ_a D_aᵀ ∈ row space of levels 1–3's tasks (checked by projecting
+    // onto their null space), λ ≥ 0 at an upper bound, ≤ 0 at a lower one.
+    const auto& last = r.levels[3];
+    deferred_active += last.num_active > 0;
+    Eigen::MatrixXd Dall(5, N);
+    Dall << L[0].D, L[1].D, L[2].D;
+    Eigen::MatrixXd Ahigh(6, N);
+    Ahigh << L[0].A, L[1].A, L[2].A;
+    Eigen::VectorXd grad = L[3].A.transpose() * (L[3].A * r.x - L[3].b);
+    double scale = (L[3].A.transpose() * L[3].A).norm() * r.x.norm() + L[3].b.norm();
+    for (int a = 0; a < last.num_active; ++a) {
+      const double lam = last.multiplier[static_cast<size_t>(a)];
+      const int row = last.active_row[static_cast<size_t>(a)];
+      EXPECT_GE(last.active_upper[static_cast<size_t>(a)] ? lam : -lam, -1e-9 * (1.0 + std::abs(lam)));
+      grad += lam * Dall.row(row).transpose();
+      scale += std::abs(lam) * Dall.row(row).norm();
+    }
+    const Eigen::MatrixXd P = Eigen::MatrixXd::Identity(N, N) -
+                              Ahigh.completeOrthogonalDecomposition().pseudoInverse() * Ahigh;
+    EXPECT_LT((P * grad).lpNorm<Eigen::Infinity>(), 1e-9 * (1.0 + scale)) << "trial " << trial;
+  }
+  EXPECT_GE(deferred, 75);        // all reachable trials, and some of the far ones
+  EXPECT_GE(cascade, 40);         // far targets pressed against rows: the cascade ran
+  EXPECT_GE(deferred_active, 40); // the last level really held rows of the levels above
+}
 
 // Degenerate vertices (the anti-cycling rule of ActiveSetQp, docs/active-set-qp.md "Iteration
 // bound"): random hierarchies, each from its own seed, with a duplicated level-2 row and a

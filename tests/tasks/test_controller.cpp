@@ -243,7 +243,7 @@ Controller::Config editedConfig(const std::string& from, const std::string& to, 
 
 // The `qp` keys reach the solvers: a magnitude bound below the robot's mass (M's base block holds
 // the total mass, 43 kg) makes each solver refuse the problem as invalid input (safe mode), and
-// dual_last_level decides how HqpWbc solves its last level.
+// dual_last_level and defer_constraints decide how HqpWbc solves its levels.
 TEST(ControllerQpSettings, YamlValuesReachTheSolvers) {
   const auto s = hqp::testing::walker3Standing();
   const double half = 0.5 * Robot::total_mass * kG;
@@ -277,6 +277,20 @@ TEST(ControllerQpSettings, YamlValuesReachTheSolvers) {
     ASSERT_EQ(ctrl->diagnostics().mode, ControllerMode::Balance);
     EXPECT_EQ(ctrl->hqp().result().levels[Controller::num_levels - 1].dual, dual);
   }
+  // Standing at rest, every level above the last reaches its unconstrained minimum within the
+  // limits: the deferred path holds when it is on, and the cascade gives the same command.
+  std::array<Eigen::VectorXd, 2> tau;
+  for (bool defer : {true, false}) {
+    auto ctrl = makeWalker3Controller(editedConfig("defer_constraints: true", defer ? "defer_constraints: true"
+                                                                                     : "defer_constraints: false",
+                                                   Solver::Hqp, s.com_height));
+    EXPECT_EQ(ctrl->hqp().settings().defer_constraints, defer);
+    ctrl->tick(sensors, cmd);
+    ASSERT_EQ(ctrl->diagnostics().mode, ControllerMode::Balance);
+    EXPECT_EQ(ctrl->hqp().result().deferred, defer);
+    tau[defer ? 0 : 1] = cmd.torque;
+  }
+  EXPECT_LT((tau[0] - tau[1]).lpNorm<Eigen::Infinity>(), 1e-9 * std::max(1.0, tau[1].lpNorm<Eigen::Infinity>()));
 }
 
 TEST(ControllerNoAlloc, TickDoesNotAllocate) {

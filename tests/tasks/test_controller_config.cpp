@@ -326,6 +326,7 @@ TEST(ControllerConfig, QpSectionDefaultsAreTheSolversDefaults) {
   EXPECT_EQ(c.qp.hqp.rank_tol, h.rank_tol);
   EXPECT_EQ(c.qp.hqp.warm_start, h.warm_start);
   EXPECT_EQ(c.qp.hqp.dual_last_level, h.dual_last_level);
+  EXPECT_EQ(c.qp.hqp.defer_constraints, h.defer_constraints);
   EXPECT_EQ(c.qp.hqp.residual_rise_tol, h.residual_rise_tol);
   EXPECT_EQ(c.qp.hqp.budget_us, 0.0);  // no budget unless asked for
   EXPECT_EQ(c.qp.hqp.budget_iterations, 0);
