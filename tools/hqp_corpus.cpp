@@ -297,13 +297,6 @@ int compareLex(const std::array<double, L>& a, const std::array<double, L>& b, d
   return 0;
 }
 
-// The solver as shipped: a file's settings, but the deferred path as the library default sets it
-// (files before version 3 record no choice and read as the cascade; x* is the same either way).
-hqp::HqpSettings shipped(hqp::HqpSettings s) {
-  s.defer_constraints = hqp::HqpSettings{}.defer_constraints;
-  return s;
-}
-
 struct Tally {
   int instances = 0, status_warm = 0, status_cold = 0, stored_not_optimal = 0;
   int x_warm_cold = 0, x_stored = 0, peer_equal = 0, hqp_better = 0, peer_better = 0, peer_failed = 0;
@@ -406,7 +399,7 @@ int checkCommand(const std::string& dir, int max, double tol, double obj_tol, bo
       continue;
     }
     if (max > 0 && static_cast<int>(v.size()) > max) v.resize(static_cast<std::size_t>(max));
-    const Tally t = check(v, shipped(info.settings), name, tol, obj_tol, verbose);
+    const Tally t = check(v, info.shippedSettings(), name, tol, obj_tol, verbose);
     std::printf("%-18s %5d %12d %12d %9d %9d %11d %11d %10d %10d %8d %8d %10.1f\n", name, t.instances, t.status_warm,
                 t.status_cold, t.x_warm_cold, t.x_stored, t.stored_not_optimal, t.peer_equal, t.hqp_better,
                 t.peer_better, t.peer_failed, t.unique, t.active / std::max(1, t.instances));
@@ -425,7 +418,7 @@ int showCommand(const std::string& file, int k) {
   const std::vector<Instance> v = hqp::readProblemFile<Wbc>(file, &info);
   if (k < 0 || k >= static_cast<int>(v.size())) throw std::runtime_error("no instance " + std::to_string(k));
   const Instance& in = v[static_cast<std::size_t>(k)];
-  auto wbc = std::make_unique<Wbc>(shipped(info.settings));
+  auto wbc = std::make_unique<Wbc>(info.shippedSettings());
   wbc->setKktResiduals(true);  // the certificate says which of two disagreeing solves is optimal
   std::printf("%s instance %d (tick %lld, t = %.3f s)\n", file.c_str(), k, static_cast<long long>(in.tick), in.time);
   std::array<Eigen::Matrix<double, NX, 1>, 2> x;

@@ -103,11 +103,7 @@ void BM_Corpus(benchmark::State& state, const char* name, bool warm) {
   }
   const auto& v = fam.instances;
   const std::size_t n = v.size();
-  // The solver as shipped: the file's settings, but the deferred path as the library default
-  // sets it (files before version 3 read as the cascade that recorded them; same x*).
-  hqp::HqpSettings settings = fam.info.settings;
-  settings.defer_constraints = hqp::HqpSettings{}.defer_constraints;
-  auto wbc = std::make_unique<Wbc>(settings);  // ~0.36 MB: not on the stack
+  auto wbc = std::make_unique<Wbc>(fam.info.shippedSettings());  // ~0.36 MB: not on the stack
   auto peer = std::make_unique<Peer>();
   std::vector<std::vector<double>> th(n), tp(n);
   std::vector<double> pooled_h, pooled_p;

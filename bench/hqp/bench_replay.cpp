@@ -1,6 +1,7 @@
 // Real problem instances: replays the HqpWbc problems recorded in a MuJoCo run
 // (bench/data/walker3_recording.hqprec, docs/recording.md) through HqpWbc, warm from each
-// instance's recorded incoming working sets, as in the run (warm:1), or cold (warm:0).
+// instance's recorded incoming working sets, as in the run (warm:1), or cold (warm:0), with the
+// run's settings but the solver's current path (ProblemFileInfo::shippedSettings).
 // Linked into bench_hqp so that the synthetic BM_HqpWarm runs in the same process and minutes:
 //   taskset -c 1 bench_hqp --benchmark_filter='HqpReplay|HqpWarm/levels_1-4|FillOnly' \
 //       --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
@@ -92,7 +93,7 @@ void BM_HqpReplay(benchmark::State& state) {
   const auto& v = rec.instances;
   const std::size_t n = v.size();
   static std::unique_ptr<Replay> wbc;  // ~0.36 MB (docs/hqp.md): not on the stack
-  if (!wbc) wbc = std::make_unique<Replay>(rec.info.settings);
+  if (!wbc) wbc = std::make_unique<Replay>(rec.info.shippedSettings());
   // Solve times, pooled (every replayed solve) and per instance; L levels + the whole solve.
   std::array<std::vector<double>, L + 1> pooled;
   std::array<std::vector<std::vector<double>>, L + 1> per_instance;
@@ -155,7 +156,7 @@ void BM_HqpReplayLoadOnly(benchmark::State& state) {
   }
   const auto& v = rec.instances;
   static std::unique_ptr<Replay> wbc;
-  if (!wbc) wbc = std::make_unique<Replay>(rec.info.settings);
+  if (!wbc) wbc = std::make_unique<Replay>(rec.info.shippedSettings());
   std::size_t k = 0;
   for (auto _ : state) {
     hqp::loadInstance(v[k], *wbc, true);

@@ -9,6 +9,9 @@
 // A basis (not the projector N_p) makes every lower QP smaller: 30 → 24 → 12 → 9 variables
 // for the paper's full-rank levels. Each level's QP is an ActiveSetQp sized at compile time
 // for that level, owned here and warm-started from the previous tick.
+// Deferred constraints (HqpSettings::defer_constraints): first the levels above the last take
+// their unconstrained steps and the last level's QP holds every row; if it ends Optimal that is
+// the same optimum (each higher level at its unconstrained minimum), else the cascade above runs.
 // See docs/hqp.md for the guarantees, the infeasibility policy and the slack option.
 
 #include <Eigen/Core>
@@ -111,7 +114,8 @@ struct HqpLevelResult {
   // Certificate: multiplier[a] is λ of active_row[a] in this level's QP (rows of this level and
   // of higher ones), for the objective ½‖W^½(A_p x − b_p)‖²: Zᵀ(A_pᵀ W (A_p x*_p − b_p) +
   // Σ_a λ_a D_aᵀ) = 0, λ_a ≥ 0 at an upper bound (active_upper), ≤ 0 at a lower bound. 0 unless
-  // the level's QP ended Optimal (free steps and levels without constraints have none).
+  // the level's QP ended Optimal (free steps, levels without constraints and, on the deferred
+  // path, the levels above the last have none).
   std::array<double, MaxActive> multiplier{};
   HqpKkt kkt{};                      // its residuals (HqpSettings::kkt_residuals)
 };
@@ -132,6 +136,7 @@ struct HqpResult {
   // The solve took the deferred path (HqpSettings::defer_constraints): the levels above the
   // last report no QP and no active row, the last level holds every constraint row.
   bool deferred = false;
+  bool deferred_tried = false;  // it was tried (deferred false: it failed, the cascade ran)
   std::array<HqpLevelResult<MaxActive>, NumLevels> levels{};
 };
 
@@ -267,6 +272,7 @@ class HqpWbc {
     begin();
     result_.higher_level_degraded = false;
     result_.deferred = false;
+    result_.deferred_tried = false;
     if (!inputValid()) {
       for (auto& lr : result_.levels) lr = HqpLevelResult<max_active>{};
       result_.status = QpStatus::InvalidInput;
@@ -276,6 +282,7 @@ class HqpWbc {
       return result_.status;
     }
     if (deferAllowed()) {
+      result_.deferred_tried = true;
       deferred_ = true;
       aborted_ = false;
       solveLevels(std::make_index_sequence<sizeof...(Levels)>{});
@@ -453,11 +460,23 @@ class HqpWbc {
   }
 
   // HqpSettings::defer_constraints: worth trying only where some constraint row would be
-  // checked above the last level.
+  // checked above the last level, and only while no level above the last holds a working set:
+  // one is left there only by a cascade in which a row held that level away from its minimum
+  // (levels that ended at it are emptied, below), so the attempt would fail again. A rule on
+  // the working sets alone, so that recorded instances replay exactly.
   bool deferAllowed() const {
     return num_levels > 1 && constraint_offset[num_levels - 1] > 0 &&
            settings_.defer_constraints && !(settings_.budget_us > 0.0) &&
-           settings_.budget_iterations <= 0;
+           settings_.budget_iterations <= 0 &&
+           higherWorkingSetsEmpty(std::make_index_sequence<sizeof...(Levels) - 1>{});
+  }
+  template <std::size_t... I>
+  bool higherWorkingSetsEmpty(std::index_sequence<I...>) const {
+    const auto empty = [](const auto& qp) {
+      if constexpr (std::is_same_v<std::decay_t<decltype(qp)>, detail::NoQp>) return true;
+      else return qp.numActive() == 0;
+    };
+    return (empty(std::get<I>(qps_)) && ...);
   }
   // After a deferred solve the levels above the last ran no QP: their working sets are empty,
   // as after a free step, so the warm state stays the working sets alone.
@@ -716,6 +735,16 @@ class HqpWbc {
       // The QP's own data (u in its coordinates: u' or, direct, u) and its multipliers.
       if (settings_.kkt_residuals && qp.x().size() == n)
         kktStationarity(lr, qp.A(), qp.b(), qp.x(), qp.C());
+      // A level above the last that ended at its unconstrained minimum (no multiplier above
+      // rounding) empties its working set, so that the next solve tries the deferred path.
+      if (!last && settings_.defer_constraints && lr.status == QpStatus::Optimal) {
+        const double tol = 1e-9 * scale * bq_.norm();
+        bool free = true;
+        for (int a = 0; a < lr.num_active; ++a)
+          free = free && std::abs(lr.multiplier[static_cast<std::size_t>(a)]) *
+                                 Dnorm_(lr.active_row[static_cast<std::size_t>(a)]) <= tol;
+        if (free) qp.resetWorkingSet();
+      }
     }
 
     // x*_p = x*_{p−1} + Z_{p−1} Q u' (eq. 4): update the reduced right-hand sides of every

@@ -35,6 +35,14 @@ struct ProblemFileInfo {
   std::string source;                           // free text: scenario, window, command
   std::uint64_t count = 0;                      // instances
   std::uint64_t header_bytes = 0, record_bytes = 0;
+  // The run's settings with the path the solver takes today (HqpSettings::defer_constraints, which
+  // does not change x*; files before version 3 read as the cascade that recorded them): what
+  // benchmarks and the corpus check time and check. Exact replays use `settings`.
+  HqpSettings shippedSettings() const {
+    HqpSettings s = settings;
+    s.defer_constraints = HqpSettings{}.defer_constraints;
+    return s;
+  }
 };
 
 namespace problem_file {

@@ -206,6 +206,7 @@ TEST(HqpInequality, DeferredPathGivesTheCascadesOptimum) {
     const auto ref = hqp::testing::bruteForceCascade(L, N);
     fill(on, L);
     fill(off, L);
+    on.resetWarmStart();  // each trial on its own (the next test covers the warm sequence)
     const hqp::QpStatus s = on.solve();
     const hqp::QpStatus s_off = off.solve();
     // The same status, or the deferred path found the optimum (its certificate is checked
@@ -263,6 +264,44 @@ TEST(HqpInequality, DeferredPathGivesTheCascadesOptimum) {
   EXPECT_GE(deferred, 75);        // all reachable trials, and some of the far ones
   EXPECT_GE(cascade, 40);         // far targets pressed against rows: the cascade ran
   EXPECT_GE(deferred_active, 40); // the last level really held rows of the levels above
+}
+
+// When the deferred path is tried (docs/hqp.md): only while no level above the last holds a
+// working set. A cascade that a row held away from a higher level's minimum leaves that row
+// there, so the next warm solve of the same problem skips the attempt; a cascade whose higher
+// levels end at their minima empties their working sets, and the next solve tries again.
+TEST(HqpInequality, DeferredPathIsRetriedOnlyAfterAFreeCascade) {
+  std::mt19937 g(53);
+  static Wbc wbc;
+  int checked = 0;
+  for (int trial = 0; trial < 40 && checked < 10; ++trial) {
+    Eigen::VectorXd x0;
+    auto far = makeLevels(0, g, &x0);
+    auto near = far;
+    for (int p = 0; p < 3; ++p) near[static_cast<size_t>(p)].b = near[static_cast<size_t>(p)].A * x0;
+    wbc.resetWarmStart();
+    fill(wbc, far);
+    wbc.solve();
+    if (wbc.result().deferred) continue;  // far targets that happen to be reachable
+    ASSERT_TRUE(wbc.result().deferred_tried);
+    const Eigen::VectorXd x_far = wbc.result().x;
+    int held = 0;  // rows left in the higher levels' working sets
+    for (int p = 0; p < 3; ++p) held += wbc.result().levels[static_cast<size_t>(p)].num_active;
+    ASSERT_GT(held, 0);
+    wbc.solve();  // the same problem, warm: the attempt would fail again
+    EXPECT_FALSE(wbc.result().deferred_tried) << "trial " << trial;
+    EXPECT_LT((wbc.result().x - x_far).lpNorm<Eigen::Infinity>(), 1e-9 * std::max(1.0, x_far.norm()));
+    fill(wbc, near);
+    wbc.solve();  // still skipped: the far problem's rows are in the working sets
+    EXPECT_FALSE(wbc.result().deferred_tried) << "trial " << trial;
+    const Eigen::VectorXd x_near = wbc.result().x;
+    wbc.solve();  // that cascade ended every higher level at its minimum: tried, and it holds
+    EXPECT_TRUE(wbc.result().deferred_tried) << "trial " << trial;
+    EXPECT_TRUE(wbc.result().deferred) << "trial " << trial;
+    EXPECT_LT((wbc.result().x - x_near).lpNorm<Eigen::Infinity>(), 1e-9 * std::max(1.0, x_near.norm()));
+    ++checked;
+  }
+  EXPECT_EQ(checked, 10);
 }
 
 // Degenerate vertices (the anti-cycling rule of ActiveSetQp, docs/active-set-qp.md "Iteration
