@@ -292,7 +292,14 @@ class HqpWbc {
       else resetHigherWorkingSets(std::make_index_sequence<sizeof...(Levels) - 1>{});
       aborted_ = false;
     }
-    if (!result_.deferred) solveLevels(std::make_index_sequence<sizeof...(Levels)>{});
+    if (!result_.deferred) {
+      higher_free_ = true;
+      solveLevels(std::make_index_sequence<sizeof...(Levels)>{});
+      // Every level above the last ended at its unconstrained minimum: the next solve tries the
+      // deferred path (their working sets emptied). Otherwise they keep their warm starts.
+      if (settings_.defer_constraints && higher_free_ && result_.cut_level < 0)
+        resetHigherWorkingSets(std::make_index_sequence<sizeof...(Levels) - 1>{});
+    }
     reconstructX(num_levels);
     // Never a non-finite x: fall back to the last finite x*_p of the higher levels (or 0),
     // with a non-optimal status at the first level left out.
@@ -461,9 +468,9 @@ class HqpWbc {
 
   // HqpSettings::defer_constraints: worth trying only where some constraint row would be
   // checked above the last level, and only while no level above the last holds a working set:
-  // one is left there only by a cascade in which a row held that level away from its minimum
-  // (levels that ended at it are emptied, below), so the attempt would fail again. A rule on
-  // the working sets alone, so that recorded instances replay exactly.
+  // a cascade keeps them only if a row held some level above the last away from its minimum
+  // (else solve() empties them), and then the attempt would fail again. A rule on the working
+  // sets alone, so that recorded instances replay exactly.
   bool deferAllowed() const {
     return num_levels > 1 && constraint_offset[num_levels - 1] > 0 &&
            settings_.defer_constraints && !(settings_.budget_us > 0.0) &&
@@ -735,15 +742,15 @@ class HqpWbc {
       // The QP's own data (u in its coordinates: u' or, direct, u) and its multipliers.
       if (settings_.kkt_residuals && qp.x().size() == n)
         kktStationarity(lr, qp.A(), qp.b(), qp.x(), qp.C());
-      // A level above the last that ended at its unconstrained minimum (no multiplier above
-      // rounding) empties its working set, so that the next solve tries the deferred path.
-      if (!last && settings_.defer_constraints && lr.status == QpStatus::Optimal) {
+      // Did a row hold this level away from its unconstrained minimum (a multiplier above
+      // rounding)? If none did at any level above the last, solve() empties their working sets.
+      if (!last) {
         const double tol = 1e-9 * scale * bq_.norm();
-        bool free = true;
+        bool free = lr.status == QpStatus::Optimal;
         for (int a = 0; a < lr.num_active; ++a)
           free = free && std::abs(lr.multiplier[static_cast<std::size_t>(a)]) *
                                  Dnorm_(lr.active_row[static_cast<std::size_t>(a)]) <= tol;
-        if (free) qp.resetWorkingSet();
+        higher_free_ = higher_free_ && free;
       }
     }
 
@@ -1158,6 +1165,7 @@ class HqpWbc {
   Result result_{};
   bool deferred_ = false;  // solving on the deferred path (HqpSettings::defer_constraints)
   bool aborted_ = false;   // the deferred path failed; the cascade runs
+  bool higher_free_ = true;  // the cascade: no row held a level above the last so far
   VectorM kkt_e_;                // certificate scratch: A u − b
   VectorU kkt_s_;                // its stationarity vector
   VectorC kkt_d_ = VectorC::Zero();  // D x at the last level
