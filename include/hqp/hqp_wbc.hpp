@@ -72,7 +72,8 @@ struct HqpSettings {
   // and the last level's QP holds every constraint row. If that QP ends Optimal, each higher
   // level sits at its unconstrained minimum at a point meeting all rows, so x is the
   // lexicographic optimum; otherwise the cascade runs from the start (the attempt's work is
-  // lost). Not tried with a budget (budget_us, budget_iterations).
+  // lost). Not tried with an iteration budget; with a time budget the cascade takes over where a
+  // level would be cut.
   bool defer_constraints = true;
 };
 
@@ -473,8 +474,7 @@ class HqpWbc {
   // sets alone, so that recorded instances replay exactly.
   bool deferAllowed() const {
     return num_levels > 1 && constraint_offset[num_levels - 1] > 0 &&
-           settings_.defer_constraints && !(settings_.budget_us > 0.0) &&
-           settings_.budget_iterations <= 0 &&
+           settings_.defer_constraints && settings_.budget_iterations <= 0 &&
            higherWorkingSetsEmpty(std::make_index_sequence<sizeof...(Levels) - 1>{});
   }
   template <std::size_t... I>
@@ -509,6 +509,10 @@ class HqpWbc {
     if (aborted_) return;  // the deferred path failed: the cascade starts over
     std::chrono::steady_clock::time_point start{};
     if (clock) start = std::chrono::steady_clock::now();
+    if (deferred_ && P > 0 && overBudget(P, start)) {  // a cut is the cascade's to make
+      aborted_ = true;
+      return;
+    }
     if (result_.cut_level < 0 && P > 0 && overBudget(P, start)) {
       result_.cut_level = P;
       // A cut level never refreshes its estimate: halve it, so that one slow solve cuts the
