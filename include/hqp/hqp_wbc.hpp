@@ -748,7 +748,7 @@ class HqpWbc {
         kktStationarity(lr, qp.A(), qp.b(), qp.x(), qp.C());
       // Did a row hold this level away from its unconstrained minimum (a multiplier above
       // rounding)? If none did at any level above the last, solve() empties their working sets.
-      if (!last) {
+      if (!last && settings_.defer_constraints) {  // read only by the deferred path's rule
         const double tol = 1e-9 * scale * bq_.norm();
         bool free = lr.status == QpStatus::Optimal;
         for (int a = 0; a < lr.num_active; ++a)
