@@ -301,7 +301,8 @@ class HqpWbc {
       if (settings_.defer_constraints && higher_free_ && result_.cut_level < 0)
         resetHigherWorkingSets(std::make_index_sequence<sizeof...(Levels) - 1>{});
     }
-    reconstructX(num_levels);
+    if (result_.deferred) deferredX();
+    else reconstructX(num_levels);
     // Never a non-finite x: fall back to the last finite x*_p of the higher levels (or 0),
     // with a non-optimal status at the first level left out.
     if (!x_.allFinite()) {
@@ -421,6 +422,11 @@ class HqpWbc {
   // final x against its value at x*_p. ‖x*_p‖ ≤ Σ_{q ≤ p} ‖u'_q‖ (orthonormal bases).
   // O(total task rows · Nx) per solve.
   void checkHealth() {
+    constexpr int T = total_task_rows;
+    // All rows at once (column-major A_: one gemv and a column-wise sum, vectorized).
+    he_.template head<T>().noalias() = A_.template topRows<T>() * x_;
+    he_.template head<T>() -= b_.template head<T>();
+    ha_.template head<T>() = A_.template topRows<T>().rowwise().squaredNorm();
     double xs = 0.0;  // bound of ‖x*_p‖
     for (int p = 0; p < num_levels; ++p) {
       const std::size_t ps = static_cast<std::size_t>(p);
@@ -430,8 +436,8 @@ class HqpWbc {
       double an2 = 0.0, bn2 = 0.0, e2 = 0.0, e2u = 0.0;
       for (int i = t0; i < t0 + r; ++i) {
         const double w = w_(i);
-        const double e = A_.row(i).dot(x_) - b_(i);
-        an2 += w * A_.row(i).squaredNorm();
+        const double e = he_(i);
+        an2 += w * ha_(i);
         bn2 += w * b_(i) * b_(i);
         e2 += w * e * e;
         e2u += e * e;
@@ -599,6 +605,8 @@ class HqpWbc {
     constexpr int own = c - c0;
     // Rows below this level's tasks (lower tasks, then all constraint rows) in W_.
     constexpr int below = total_task_rows + total_constraint_rows - (t0 + r);
+    // Of those, the task rows of the levels above the last: all the deferred path rotates.
+    constexpr int higher_below = std::max(task_offset[num_levels - 1] - (t0 + r), 0);
     auto& lr = result_.levels[P];
     lr = HqpLevelResult<max_active>{};
     const int n = n_;
@@ -620,6 +628,9 @@ class HqpWbc {
       return;
     }
 
+    if constexpr (P + 1 == num_levels && P > 0) {
+      if (deferred_) deferredRows<P>(n);
+    }
     // Â_p = W^½ A_p Z_{p−1} (r x n) and its null space (eq. 4).
     const auto sw = w_.template segment<r>(t0).cwiseSqrt();
     M_ = W_.block(t0, col0, r, n);
@@ -641,7 +652,12 @@ class HqpWbc {
     constexpr bool last = P + 1 == num_levels;
     bool rotated = false;
     auto rotateBelow = [&] {
-      if constexpr (below > 0) {
+      if (!last && deferred_) {  // the last level's rows: formed there (deferredRows)
+        if constexpr (higher_below > 0) {
+          auto rows_below = W_.block(t0 + r, col0, higher_below, n);
+          ns.applyQOnTheRight(rows_below);
+        }
+      } else if constexpr (below > 0) {
         auto rows_below = W_.block(t0 + r, col0, below, n);
         ns.applyQOnTheRight(rows_below);
       }
@@ -769,7 +785,11 @@ class HqpWbc {
       ns.applyQOnTheLeft(q_);
     }
     up_[P] = u_;
-    if constexpr (below > 0 && !last) {  // after the last level nobody reads bt_ or dx_
+    if (deferred_) {  // only the higher levels' task rows (the last level's: deferredRows)
+      if constexpr (higher_below > 0)
+        bt_.segment(t0 + r, higher_below).noalias() -=
+            W_.block(t0 + r, col0, higher_below, n) * u_;
+    } else if constexpr (below > 0 && !last) {  // after the last level nobody reads bt_ or dx_
       tmp_.head(below).noalias() = W_.block(t0 + r, col0, below, n) * u_;
       if constexpr (below > total_constraint_rows)
         bt_.segment(t0 + r, below - total_constraint_rows) -=
@@ -858,6 +878,49 @@ class HqpWbc {
     return true;
   }
 
+  // The deferred path's last level: its task rows and every constraint row times Z_{p−1}
+  // into W_, and their reduced right-hand sides b − A x*_{p−1}, D x*_{p−1}. The levels above
+  // rotated only their own task rows; Z_{p−1} = Q_0 E_0 ⋯ Q_{p−1} E_{p−1} (E = [0; I], the
+  // null-space columns) is formed once on its n columns, from the right, and multiplied in:
+  // about half the flops of rotating these rows at every level (docs/hqp.md).
+  template <int P>
+  void deferredRows(int n) {
+    constexpr int r = LevelType<P>::task_rows;
+    constexpr int t0 = task_offset[P];
+    constexpr int c = total_constraint_rows;
+    // Zᵀ = E_{p−1}ᵀ Q_{p−1}ᵀ ⋯ E_0ᵀ Q_0ᵀ from the left: [0 I] in the last var_[q] columns,
+    // times Q_qᵀ (n rows instead of every row below, 8 at a time).
+    Zt_.setZero(n, Nx);
+    Zt_.rightCols(n).setIdentity();
+    for (int q = P - 1; q >= 0; --q) {
+      const int m = var_[static_cast<std::size_t>(q)];
+      auto cols = Zt_.block(0, Nx - m, n, m);
+      ns_[static_cast<std::size_t>(q)].applyQTransposeOnTheRight(cols);
+    }
+    // The rows from A_p on in W_ are still A_p and D (begin(), only the higher task rows
+    // were rotated): their product with Z, in place into the last n columns.
+    {
+      constexpr int rows = total_task_rows + total_constraint_rows - t0;
+      auto Wl = W_.template middleRows<rows>(t0);
+      detail::multiplyRowStrips<Nx>(Wl, rows, Nx, Zt_, n);
+    }
+    reconstructX(P);  // x*_{p−1}
+    xd_ = x_;
+    bt_.template segment<r>(t0) = b_.template segment<r>(t0);
+    bt_.template segment<r>(t0).noalias() -= A_.template middleRows<r>(t0) * x_;
+    dx_.template head<c>().noalias() = D_.template topRows<c>() * x_;
+  }
+
+  // The deferred path's x = x*_{p−1} + Z_{p−1} u of the last level p (deferredRows' Zᵀ and
+  // x*_{p−1}): one product instead of the chain of every level's reflectors.
+  void deferredX() {
+    constexpr std::size_t L = num_levels - 1;
+    q_ = up_[L];
+    if (!unrotated_[L]) ns_[L].applyQOnTheLeft(q_);
+    x_ = xd_;
+    x_.noalias() += Zt_.transpose() * q_;
+  }
+
   // e = A_p x*_p − b_p.
   template <int P, class Vec>
   void finishLevel(HqpLevelResult<max_active>& lr, const Vec& e) {
@@ -868,7 +931,9 @@ class HqpWbc {
     lr.objective = (e.array().square() * w_.template segment<r>(t0).array()).sum();
     noteStatus(P, lr.status);
     // dx_ = D x*_p here, except after the last level (not updated): see lastLevelPrimal().
-    if (lr.kkt.computed && P + 1 < num_levels) kktRows(lr, constraint_offset[P + 1], dx_);
+    // (On the deferred path dx_ is not kept above the last level: lastLevelPrimal checks.)
+    if (lr.kkt.computed && P + 1 < num_levels && !deferred_)
+      kktRows(lr, constraint_offset[P + 1], dx_);
   }
 
   // Certificate, stationarity (HqpKkt): s = Aᵀ(A u − b) + Σ_a λ_a C_aᵀ with the level's QP
@@ -1149,6 +1214,8 @@ class HqpWbc {
   Eigen::Matrix<double, capacity(total_task_rows + total_constraint_rows), 1> tmp_ =
       decltype(tmp_)::Zero();
   VectorC Dnorm_ = VectorC::Zero();  // row norms of D
+  // checkHealth: A x − b and the squared row norms of A.
+  Eigen::Matrix<double, capacity(total_task_rows), 1> he_ = decltype(he_)::Zero(), ha_ = he_;
   VectorC cnorm_ = VectorC::Zero();  // squared row norms of a level's reduced constraint rows
 
   // Cascade state and scratch.
@@ -1158,6 +1225,8 @@ class HqpWbc {
   std::array<int, sizeof...(Levels)> var_{}, rank_{};  // n and k of every level
   std::array<bool, sizeof...(Levels)> unrotated_{};    // u'_p = u_p (dual path: no Q_p)
   VectorU q_, v_;                // Q u' / reconstruction scratch
+  Eigen::Matrix<double, Eigen::Dynamic, Nx, 0, Nx, Nx> Zt_;  // Z_{p−1}ᵀ (deferredRows)
+  VectorX xd_ = VectorX::Zero();  // x*_{p−1} there
   MatrixM M_;                    // Â_p
   MatrixM Aq_;                   // Â_p Q (truncated)
   VectorM bq_;                   // W^½ (b_p − A_p x*_{p−1})

@@ -136,6 +136,14 @@ class NullSpace {
     }
   }
 
+  // Y ← Y Qᵀ for Y with cols() columns, 8 rows at a time (a column-major Y of fixed capacity).
+  template <class Dest>
+  void applyQTransposeOnTheRight(Dest& Y) const {
+    if (rank_ == 0) return;
+    detail::reflectRowStrips<capacity(MaxCols), true>(Y, static_cast<int>(Y.rows()), cols_, qr_,
+                                                      tau_, 0, rank_);
+  }
+
   // y ← Q y for a vector y of size cols() (e.g. u = Q u' back from the rotated coordinates).
   template <class Vec>
   void applyQOnTheLeft(Vec& y) const {

@@ -6,6 +6,7 @@
 #include <random>
 
 #include "hqp/constraint.hpp"
+#include "hqp/detail/householder_strips.hpp"
 #include "hqp/level.hpp"
 #include "hqp/null_space.hpp"
 #include "hqp/task.hpp"
@@ -79,6 +80,38 @@ TEST(NullSpace, BasisRankProjectorRotatedMatrix) {
     ++checked;
   }
   EXPECT_EQ(checked, 200);
+}
+
+// Y Qᵀ by 8-row strips (the reflectors in reverse order, a short last strip in half width)
+// against Eigen's own Householder sequence (a dynamic Y takes that path), for row counts
+// that fill strips, leave 1–4 rows or 5–7 rows over; and the in-place strip product Y Zᵀ
+// against Eigen's product.
+TEST(NullSpace, TransposeOnTheRightAndStripProductMatchEigen) {
+  std::mt19937 g(11);
+  constexpr int MaxR = 12, MaxC = 14, MaxY = 24;
+  hqp::NullSpace<MaxR, MaxC> ns;
+  using Fixed = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, MaxY, MaxC>;
+  for (int trial = 0; trial < 300; ++trial) {
+    const int r = 1 + static_cast<int>(g() % MaxR);
+    const int c = 1 + static_cast<int>(g() % MaxC);
+    const int k = static_cast<int>(g() % (std::min(r, c) + 1));
+    ns.computeRelative(randomRank(r, c, k, g), 1e-9);
+    Eigen::MatrixXd Q = Eigen::MatrixXd::Identity(c, c);
+    ns.applyQOnTheRight(Q);  // Eigen's householderSequence
+    const int rows = 1 + trial % MaxY;
+    const Eigen::MatrixXd Y0 = randomMatrix(rows, c, g);
+    Fixed Y = Y0;
+    ns.applyQTransposeOnTheRight(Y);
+    EXPECT_LT((Y - Y0 * Q.transpose()).norm(), 1e-12 * (1.0 + Y0.norm()))
+        << "trial " << trial << ", " << rows << " rows";
+
+    const int n = 1 + static_cast<int>(g() % c);
+    const Eigen::MatrixXd Zt = randomMatrix(n, c, g);
+    Fixed P = Y0;
+    hqp::detail::multiplyRowStrips<MaxC>(P, rows, c, Zt, n);
+    EXPECT_LT((P.rightCols(n) - Y0 * Zt.transpose()).norm(), 1e-12 * (1.0 + Y0.norm() * Zt.norm()))
+        << "trial " << trial << ", " << rows << " rows, n = " << n;
+  }
 }
 
 TEST(NullSpace, ThresholdCutsTinyDirections) {

@@ -70,7 +70,67 @@ inline void reflectStrip(Eigen::Matrix<double, 8, MaxCols>& strip, int cols, con
   }
 }
 
-template <int MaxCols, class MatY, class MatV, class VecTau>
+// strip ← strip H_{last−1} ⋯ H_first: the same reflectors in reverse order (Y Qᵀ where the
+// above gives Y Q). One dot pass and one update pass per reflector.
+template <int MaxCols, int S, class MatV, class VecTau>
+inline void reflectStripBackward(Eigen::Matrix<double, S, MaxCols>& strip, int cols,
+                                 const MatV& V, const VecTau& tau, int first, int last) {
+  using Vec = Eigen::Matrix<double, S, 1>;
+  for (int i = last - 1; i >= first; --i) {
+    if (tau(i) == 0.0) continue;
+    Vec t0 = strip.col(i), t1 = Vec::Zero(), t2 = Vec::Zero(), t3 = Vec::Zero();
+    int j = i + 1;
+    for (; j + 3 < cols; j += 4) {
+      t0.noalias() += V(j, i) * strip.col(j);
+      t1.noalias() += V(j + 1, i) * strip.col(j + 1);
+      t2.noalias() += V(j + 2, i) * strip.col(j + 2);
+      t3.noalias() += V(j + 3, i) * strip.col(j + 3);
+    }
+    for (; j < cols; ++j) t0.noalias() += V(j, i) * strip.col(j);
+    const Vec t = tau(i) * ((t0 + t1) + (t2 + t3));
+    strip.col(i) -= t;
+    for (j = i + 1; j < cols; ++j) strip.col(j).noalias() -= V(j, i) * t;
+  }
+}
+
+// Y Zᵀ into the last n of the cols columns of Y, in place, for rows [0, rows) of a
+// column-major Y, with Zt (n x cols, n ≤ cols): 8 rows at a time are copied out, so the
+// product can overwrite the columns it reads.
+template <int MaxCols, class MatY, class MatZ>
+inline void multiplyRowStrips(MatY&& Y, int rows, int cols, const MatZ& Zt, int n) {
+  constexpr int S = 8;
+  Eigen::Matrix<double, S, MaxCols> strip, out;
+  for (int r0 = 0; r0 < rows; r0 += S) {
+    const int h = std::min(S, rows - r0);
+    for (int l = 0; l < cols; ++l) {
+      if (h == S) strip.col(l) = Y.col(l).template segment<S>(r0);
+      else {
+        strip.col(l).setZero();
+        strip.col(l).head(h) = Y.col(l).segment(r0, h);
+      }
+    }
+    using Vec = Eigen::Matrix<double, S, 1>;
+    for (int j = 0; j < n; ++j) {  // four independent sums per column of the output
+      Vec a0 = Vec::Zero(), a1 = Vec::Zero(), a2 = Vec::Zero(), a3 = Vec::Zero();
+      int l = 0;
+      for (; l + 3 < cols; l += 4) {
+        a0.noalias() += Zt(j, l) * strip.col(l);
+        a1.noalias() += Zt(j, l + 1) * strip.col(l + 1);
+        a2.noalias() += Zt(j, l + 2) * strip.col(l + 2);
+        a3.noalias() += Zt(j, l + 3) * strip.col(l + 3);
+      }
+      for (; l < cols; ++l) a0.noalias() += Zt(j, l) * strip.col(l);
+      out.col(j) = (a0 + a1) + (a2 + a3);
+    }
+    for (int j = 0; j < n; ++j) {
+      if (h == S) Y.col(cols - n + j).template segment<S>(r0) = out.col(j);
+      else Y.col(cols - n + j).segment(r0, h) = out.col(j).head(h);
+    }
+  }
+}
+
+// Y ← Y H_first ⋯ H_{last−1} (Backward: Y H_{last−1} ⋯ H_first) on rows [0, rows).
+template <int MaxCols, bool Backward = false, class MatY, class MatV, class VecTau>
 inline void reflectRowStrips(MatY&& Y, int rows, int cols, const MatV& V, const VecTau& tau,
                              int first, int last) {
   constexpr int S = 8;
@@ -82,6 +142,18 @@ inline void reflectRowStrips(MatY&& Y, int rows, int cols, const MatV& V, const 
   // Reflectors first.. touch only columns ≥ first.
   for (int r0 = 0; r0 < rows; r0 += S) {
     const int h = std::min(S, rows - r0);
+    if constexpr (Backward) {
+      if (h <= 4) {  // a short last strip (e.g. 9 rows: 8 + 1) in half the width
+        Eigen::Matrix<double, 4, MaxCols> s4;
+        for (int j = first; j < cols; ++j) {
+          s4.col(j).setZero();
+          s4.col(j).head(h) = Y.col(j).segment(r0, h);
+        }
+        reflectStripBackward<MaxCols>(s4, cols, V, tau, first, last);
+        for (int j = first; j < cols; ++j) Y.col(j).segment(r0, h) = s4.col(j).head(h);
+        continue;
+      }
+    }
     if constexpr (kFull) {
       if (h == S)
         for (int j = first; j < cols; ++j) strip.col(j) = Y.col(j).template segment<S>(r0);
@@ -92,7 +164,8 @@ inline void reflectRowStrips(MatY&& Y, int rows, int cols, const MatV& V, const 
         strip.col(j).head(h) = Y.col(j).segment(r0, h);
       }
     }
-    reflectStrip<MaxCols>(strip, cols, V, tau, first, last);
+    if constexpr (Backward) reflectStripBackward<MaxCols>(strip, cols, V, tau, first, last);
+    else reflectStrip<MaxCols>(strip, cols, V, tau, first, last);
     if constexpr (kFull) {
       if (h == S)
         for (int j = first; j < cols; ++j) Y.col(j).template segment<S>(r0) = strip.col(j);
