@@ -84,37 +84,19 @@ class NullSpace {
       // H_i on the remaining columns, one dot + axpy per column: at these sizes (≤ 30 x 15)
       // Eigen's general block update is dominated by its call overhead.
       if (tau != 0.0 && len > 1) {
-        // Raw columns, two at a time (independent sums, one load of v for both).
-        const double* v = &qr_.coeffRef(i + 1, i);
-        const int m = len - 1;
-        int j = i + 1;
-        for (; j + 1 < rows_; j += 2) {
-          double* x = &qr_.coeffRef(i, j);
-          double* y = &qr_.coeffRef(i, j + 1);
-          double tx = 0.0, ty = 0.0;
-          for (int l = 0; l < m; ++l) {
-            tx += v[l] * x[l + 1];
-            ty += v[l] * y[l + 1];
+        const auto v = qr_.col(i).segment(i + 1, len - 1);
+        for (int j = i + 1; j < rows_; ++j) {
+          auto x = qr_.col(j).segment(i, len);
+          const double t = tau * (x(0) + v.dot(x.tail(len - 1)));
+          x(0) -= t;
+          x.tail(len - 1) -= t * v;
+          const double nj = cn_(j) - x(0) * x(0);
+          if (nj <= 1e-4 * cref_(j)) {
+            cn_(j) = x.tail(len - 1).squaredNorm();
+            cref_(j) = cn_(j);
+          } else {
+            cn_(j) = nj;
           }
-          tx = tau * (x[0] + tx);
-          ty = tau * (y[0] + ty);
-          x[0] -= tx;
-          y[0] -= ty;
-          for (int l = 0; l < m; ++l) {
-            x[l + 1] -= tx * v[l];
-            y[l + 1] -= ty * v[l];
-          }
-          downdateNorm(j, x, m);
-          downdateNorm(j + 1, y, m);
-        }
-        if (j < rows_) {
-          double* x = &qr_.coeffRef(i, j);
-          double tx = 0.0;
-          for (int l = 0; l < m; ++l) tx += v[l] * x[l + 1];
-          tx = tau * (x[0] + tx);
-          x[0] -= tx;
-          for (int l = 0; l < m; ++l) x[l + 1] -= tx * v[l];
-          downdateNorm(j, x, m);
         }
       } else {
         for (int j = i + 1; j < rows_; ++j) {
@@ -123,20 +105,6 @@ class NullSpace {
         }
       }
       rank_ = i + 1;
-    }
-  }
-
-  // Column j's squared norm below row i after step i (x = its entries from row i on, m below):
-  // downdated by x[0]², recomputed where that cancelled most of the last exact value.
-  void downdateNorm(int j, const double* x, int m) {
-    const double nj = cn_(j) - x[0] * x[0];
-    if (nj <= 1e-4 * cref_(j)) {
-      double s = 0.0;
-      for (int l = 1; l <= m; ++l) s += x[l] * x[l];
-      cn_(j) = s;
-      cref_(j) = s;
-    } else {
-      cn_(j) = nj;
     }
   }
 
