@@ -16,6 +16,25 @@
 
 namespace hqp::detail {
 
+// t = strip v_i for the reflector v_i = [1; V(i+1 : cols, i)] (columns i.. of the strip), in
+// four accumulators: t0 gets column i, then j ≡ i+1 (mod 4) and the tail past the last full
+// group of 4; t1..t3 the others.
+template <int MaxCols, int S, class MatV>
+inline Eigen::Matrix<double, S, 1> stripDot(const Eigen::Matrix<double, S, MaxCols>& strip,
+                                            int cols, const MatV& V, int i) {
+  using Vec = Eigen::Matrix<double, S, 1>;
+  Vec t0 = strip.col(i), t1 = Vec::Zero(), t2 = Vec::Zero(), t3 = Vec::Zero();
+  int j = i + 1;
+  for (; j + 3 < cols; j += 4) {
+    t0.noalias() += V(j, i) * strip.col(j);
+    t1.noalias() += V(j + 1, i) * strip.col(j + 1);
+    t2.noalias() += V(j + 2, i) * strip.col(j + 2);
+    t3.noalias() += V(j + 3, i) * strip.col(j + 3);
+  }
+  for (; j < cols; ++j) t0.noalias() += V(j, i) * strip.col(j);
+  return (t0 + t1) + (t2 + t3);
+}
+
 // strip ← strip H_first ⋯ H_{last−1} on the columns [first, cols) of a local 8-row block.
 // t = strip v of the next reflector is summed while this one updates the columns, so each
 // column is loaded once per reflector; every sum keeps its accumulator and order (t0 gets
@@ -28,30 +47,20 @@ inline void reflectStrip(Eigen::Matrix<double, 8, MaxCols>& strip, int cols, con
   int i = first;
   while (i < last && tau(i) == 0.0) ++i;
   if (i >= last) return;
-  Vec t0 = strip.col(i), t1 = Vec::Zero(), t2 = Vec::Zero(), t3 = Vec::Zero();
-  int j = i + 1;
-  for (; j + 3 < cols; j += 4) {
-    t0.noalias() += V(j, i) * strip.col(j);
-    t1.noalias() += V(j + 1, i) * strip.col(j + 1);
-    t2.noalias() += V(j + 2, i) * strip.col(j + 2);
-    t3.noalias() += V(j + 3, i) * strip.col(j + 3);
-  }
-  for (; j < cols; ++j) t0.noalias() += V(j, i) * strip.col(j);
+  Vec sum = stripDot<MaxCols>(strip, cols, V, i);
   while (i < last) {
-    const Vec t = tau(i) * ((t0 + t1) + (t2 + t3));
+    const Vec t = tau(i) * sum;
     int n = i + 1;  // the next reflector that does something
     while (n < last && tau(n) == 0.0) ++n;
     strip.col(i) -= t;
+    int j;
     if (n >= last) {
       for (j = i + 1; j < cols; ++j) strip.col(j).noalias() -= V(j, i) * t;
       return;
     }
     for (j = i + 1; j < n; ++j) strip.col(j).noalias() -= V(j, i) * t;
     strip.col(n).noalias() -= V(n, i) * t;
-    t0 = strip.col(n);
-    t1.setZero();
-    t2.setZero();
-    t3.setZero();
+    Vec t0 = strip.col(n), t1 = Vec::Zero(), t2 = Vec::Zero(), t3 = Vec::Zero();
     for (j = n + 1; j + 3 < cols; j += 4) {
       strip.col(j).noalias() -= V(j, i) * t;
       t0.noalias() += V(j, n) * strip.col(j);
@@ -66,6 +75,7 @@ inline void reflectStrip(Eigen::Matrix<double, 8, MaxCols>& strip, int cols, con
       strip.col(j).noalias() -= V(j, i) * t;
       t0.noalias() += V(j, n) * strip.col(j);
     }
+    sum = (t0 + t1) + (t2 + t3);
     i = n;
   }
 }
@@ -78,18 +88,9 @@ inline void reflectStripBackward(Eigen::Matrix<double, S, MaxCols>& strip, int c
   using Vec = Eigen::Matrix<double, S, 1>;
   for (int i = last - 1; i >= first; --i) {
     if (tau(i) == 0.0) continue;
-    Vec t0 = strip.col(i), t1 = Vec::Zero(), t2 = Vec::Zero(), t3 = Vec::Zero();
-    int j = i + 1;
-    for (; j + 3 < cols; j += 4) {
-      t0.noalias() += V(j, i) * strip.col(j);
-      t1.noalias() += V(j + 1, i) * strip.col(j + 1);
-      t2.noalias() += V(j + 2, i) * strip.col(j + 2);
-      t3.noalias() += V(j + 3, i) * strip.col(j + 3);
-    }
-    for (; j < cols; ++j) t0.noalias() += V(j, i) * strip.col(j);
-    const Vec t = tau(i) * ((t0 + t1) + (t2 + t3));
+    const Vec t = tau(i) * stripDot<MaxCols>(strip, cols, V, i);
     strip.col(i) -= t;
-    for (j = i + 1; j < cols; ++j) strip.col(j).noalias() -= V(j, i) * t;
+    for (int j = i + 1; j < cols; ++j) strip.col(j).noalias() -= V(j, i) * t;
   }
 }
 
