@@ -515,11 +515,12 @@ class HqpWbc {
     if (aborted_) return;  // the deferred path failed: the cascade starts over
     std::chrono::steady_clock::time_point start{};
     if (clock) start = std::chrono::steady_clock::now();
-    if (deferred_ && P > 0 && overBudget(P, start)) {  // a cut is the cascade's to make
+    const bool over = result_.cut_level < 0 && P > 0 && overBudget(P, start);
+    if (deferred_ && over) {  // a cut is the cascade's to make
       aborted_ = true;
       return;
     }
-    if (result_.cut_level < 0 && P > 0 && overBudget(P, start)) {
+    if (over) {
       result_.cut_level = P;
       // A cut level never refreshes its estimate: halve it, so that one slow solve cuts the
       // level for a few ticks, not for ever.
@@ -605,8 +606,12 @@ class HqpWbc {
     constexpr int own = c - c0;
     // Rows below this level's tasks (lower tasks, then all constraint rows) in W_.
     constexpr int below = total_task_rows + total_constraint_rows - (t0 + r);
-    // Of those, the task rows of the levels above the last: all the deferred path rotates.
+    constexpr bool last = P + 1 == num_levels;
+    // The rows below that this level carries into its coordinates: all of them on the cascade;
+    // above the last level on the deferred path only the task rows of the levels above the
+    // last (the last level forms its own rows and the constraint rows: deferredRows).
     constexpr int higher_below = std::max(task_offset[num_levels - 1] - (t0 + r), 0);
+    const int carried = deferred_ && !last ? higher_below : below;
     auto& lr = result_.levels[P];
     lr = HqpLevelResult<max_active>{};
     const int n = n_;
@@ -649,16 +654,10 @@ class HqpWbc {
     // u' = [row-space part (k); null part (n − k)], so Z_p is the last n − k columns.
     // The last level's rows below are only its QP's constraint rows: rotated only if the
     // QP runs (the free step below needs them only times a vector).
-    constexpr bool last = P + 1 == num_levels;
     bool rotated = false;
     auto rotateBelow = [&] {
-      if (!last && deferred_) {  // the last level's rows: formed there (deferredRows)
-        if constexpr (higher_below > 0) {
-          auto rows_below = W_.block(t0 + r, col0, higher_below, n);
-          ns.applyQOnTheRight(rows_below);
-        }
-      } else if constexpr (below > 0) {
-        auto rows_below = W_.block(t0 + r, col0, below, n);
+      if (carried > 0) {
+        auto rows_below = W_.block(t0 + r, col0, carried, n);
         ns.applyQOnTheRight(rows_below);
       }
       rotated = true;
@@ -785,18 +784,13 @@ class HqpWbc {
       ns.applyQOnTheLeft(q_);
     }
     up_[P] = u_;
-    if (deferred_) {  // only the higher levels' task rows (the last level's: deferredRows)
-      if constexpr (higher_below > 0)
-        bt_.segment(t0 + r, higher_below).noalias() -=
-            W_.block(t0 + r, col0, higher_below, n) * u_;
-    } else if constexpr (below > 0 && !last) {  // after the last level nobody reads bt_ or dx_
-      tmp_.head(below).noalias() = W_.block(t0 + r, col0, below, n) * u_;
-      if constexpr (below > total_constraint_rows)
-        bt_.segment(t0 + r, below - total_constraint_rows) -=
-            tmp_.head(below - total_constraint_rows);
-      if constexpr (total_constraint_rows > 0)
-        dx_.head(total_constraint_rows) += tmp_.segment(below - total_constraint_rows,
-                                                        total_constraint_rows);
+    if (!last && carried > 0) {  // after the last level nobody reads bt_ or dx_
+      // The carried rows: lower task rows first, then (cascade only) every constraint row.
+      constexpr int task_below = below - total_constraint_rows;
+      const int tasks = std::min(carried, task_below);
+      tmp_.head(carried).noalias() = W_.block(t0 + r, col0, carried, n) * u_;
+      if (tasks > 0) bt_.segment(t0 + r, tasks) -= tmp_.head(tasks);
+      if (carried > tasks) dx_.head(carried - tasks) += tmp_.segment(tasks, carried - tasks);
     }
     const Eigen::Matrix<double, r, 1> e =
         W_.block(t0, col0, r, n) * q_ - bt_.template segment<r>(t0);
