@@ -9,10 +9,14 @@
 //       level objectives against the peer cascade (peer_cascade.hpp). Exit 1 on a mismatch.
 //   hqp_corpus show FILE K
 //       one instance per level: warm, cold and the peer (objective, status, iterations).
+//   hqp_corpus dump FILE OUT.json
+//       every instance's rows and bounds (±inf as null) with the warm solve's x and statuses,
+//       for an independent check of each level (tools/hqp_oracle.py).
 // Deterministic: the random numbers come from std::mt19937_64 through our own uniform and
 // normal transforms (the standard distributions differ between standard libraries).
 // The shape is Walker3's balance hierarchy (Table I), as for hqp_replay.
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <array>
@@ -450,6 +454,59 @@ int showCommand(const std::string& file, int k) {
   return 0;
 }
 
+nlohmann::json rowsJson(const Eigen::Ref<const Eigen::MatrixXd>& m) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < m.rows(); ++i) {
+    nlohmann::json row = nlohmann::json::array();
+    for (Eigen::Index j = 0; j < m.cols(); ++j) row.push_back(m(i, j));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+nlohmann::json vectorJson(const Eigen::Ref<const Eigen::VectorXd>& v) {
+  nlohmann::json out = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) {
+    if (std::isfinite(v(i))) out.push_back(v(i));
+    else out.push_back(nullptr);  // ±inf: no bound (the side tells which)
+  }
+  return out;
+}
+
+int dumpCommand(const std::string& file, const std::string& out_path) {
+  hqp::ProblemFileInfo info;
+  const std::vector<Instance> v = hqp::readProblemFile<Wbc>(file, &info);
+  auto wbc = std::make_unique<Wbc>(info.shippedSettings());
+  nlohmann::json doc;
+  doc["source"] = file;
+  doc["task_offset"] = std::vector<int>(Wbc::task_offset.begin(), Wbc::task_offset.end());
+  doc["constraint_offset"] = std::vector<int>(Wbc::constraint_offset.begin(), Wbc::constraint_offset.end());
+  nlohmann::json list = nlohmann::json::array();
+  for (const Instance& in : v) {
+    hqp::loadInstance(in, *wbc, true);
+    wbc->solve();
+    nlohmann::json j;
+    j["A"] = rowsJson(in.A);
+    j["b"] = vectorJson(in.b);
+    j["w"] = vectorJson(in.w);
+    j["D"] = rowsJson(in.D);
+    j["lower"] = vectorJson(in.lower);
+    j["upper"] = vectorJson(in.upper);
+    j["x"] = vectorJson(wbc->result().x);
+    nlohmann::json status = nlohmann::json::array();
+    for (const auto& l : wbc->result().levels) status.push_back(hqp::toString(l.status));
+    j["status"] = status;
+    list.push_back(j);
+  }
+  doc["instances"] = list;
+  std::ofstream out(out_path);
+  if (!out) throw std::runtime_error(out_path + ": cannot open for writing");
+  out << doc.dump() << "\n";  // shortest round-trip representation of every double
+  if (!out) throw std::runtime_error(out_path + ": write error");
+  std::printf("%s: %zu instances\n", out_path.c_str(), v.size());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -476,6 +533,10 @@ int main(int argc, char** argv) {
   auto* shw = app.add_subcommand("show", "one instance in detail: warm, cold and the peer per level");
   shw->add_option("file", show_file, "a family file")->required();
   shw->add_option("instance", show_k, "0-based index")->required();
+  std::string dump_file, dump_out;
+  auto* dmp = app.add_subcommand("dump", "instances and warm solutions as JSON (tools/hqp_oracle.py)");
+  dmp->add_option("file", dump_file, "a family file")->required();
+  dmp->add_option("out", dump_out, "the JSON file to write")->required();
   CLI11_PARSE(app, argc, argv);
   try {
     if (*gen) {
@@ -486,6 +547,7 @@ int main(int argc, char** argv) {
       return generate(seeds, scenarios, base, out, max_per_line);
     }
     if (*shw) return showCommand(show_file, show_k);
+    if (*dmp) return dumpCommand(dump_file, dump_out);
     return checkCommand(dir, max, tol, obj_tol, verbose);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hqp_corpus: %s\n", e.what());

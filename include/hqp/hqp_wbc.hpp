@@ -840,11 +840,26 @@ class HqpWbc {
       dlo_(i) = lo;
       dup_(i) = up;
     }
-    // The level's working set (the previous tick's active set, or a recorded one) goes first.
+    // Any order of the violated rows is valid for the dual method, and an order that ends on
+    // nearly dependent rows (NumericalFailure) may be avoided by another, so up to three run
+    // before the general path: the level's working set first (the previous tick's active set,
+    // or a recorded one), then the method's own (most violated first), then, on the cascade,
+    // the level above's working set (its rows hold at x*_{p−1}).
     auto& qp = std::get<P>(qps_);
-    const int prefer = settings_.warm_start ? DualQp::preferredRows(qp, n, prefer_) : 0;
-    if (dual_.solve(Cw, dlo_, dup_, c, settings_.qp, prefer_.data(), prefer) != QpStatus::Optimal)
-      return false;
+    const int own = settings_.warm_start ? DualQp::preferredRows(qp, n, prefer_) : 0;
+    QpStatus s = dual_.solve(Cw, dlo_, dup_, c, settings_.qp, prefer_.data(), own);
+    if (s == QpStatus::NumericalFailure && own > 0 && dual_.factorize(M_, bq_, r, n, min_sigma))
+      s = dual_.solve(Cw, dlo_, dup_, c, settings_.qp);
+    if constexpr (P > 0) {
+      const auto& above = result_.levels[P - 1];
+      if (s == QpStatus::NumericalFailure && !deferred_ && above.num_active > 0 &&
+          dual_.factorize(M_, bq_, r, n, min_sigma)) {
+        const int cnt = std::min(above.num_active, static_cast<int>(prefer_.size()));
+        std::copy_n(above.active_row.begin(), cnt, prefer_.begin());
+        s = dual_.solve(Cw, dlo_, dup_, c, settings_.qp, prefer_.data(), cnt);
+      }
+    }
+    if (s != QpStatus::Optimal) return false;
     u_ = dual_.x();
     aborted_ = false;
     lr.status = QpStatus::Optimal;

@@ -23,6 +23,9 @@
 #ifndef HQP_RECORDING_FILE
 #define HQP_RECORDING_FILE ""
 #endif
+#ifndef HQP_STRESS_CASE_FILE
+#define HQP_STRESS_CASE_FILE ""
+#endif
 
 namespace {
 
@@ -131,6 +134,51 @@ TEST(Recording, ColdReplayFindsTheSameSolution) {
 }
 
 // Bytes → instances → bytes is the identity on the checked-in file.
+// Three stress instances of the corpus (hqp_corpus generate: bounds shrunk toward a solution, task
+// references moved) whose last level has nearly dependent rows at its optimum (condition of the
+// active rows 1e6–3e7). Their optima were computed independently with scipy
+// (tools/hqp_oracle.py: SLSQP, and trust-constr then SLSQP from there) on
+// min ‖W^½(A₄ x − b₄)‖² over x = x₃ + N z (N: null space of the higher task rows, whose optimal
+// values are unique) within every bound, feasible to 1e-13.
+// The last level's dual method once stopped on 185 at 9676 with multipliers of 1e16 and reported
+// Optimal (a row nearly dependent on the active ones was added); on 108, warm-started from
+// level 3's working set (as stored in the file), it failed, and the general path then reported
+// Optimal at 2842; on 274 it failed in its first two orders, and the general path reported
+// Optimal at 7434.
+TEST(Recording, IllConditionedLastLevelReachesItsOptimum) {
+  hqp::ProblemFileInfo info;
+  const auto v = hqp::readProblemFile<Replay>(HQP_STRESS_CASE_FILE, &info);
+  ASSERT_EQ(v.size(), 3u);
+  const double optimum[3] = {1977.0146988, 1646.1729438, 6255.8395690};  // 185, 108, 274
+  constexpr int t3 = Replay::task_offset[3];
+  constexpr int r3 = Replay::total_task_rows - t3;
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    const Instance& in = v[k];
+    for (const bool defer : {true, false}) {
+      hqp::HqpSettings s = info.settings;
+      s.defer_constraints = defer;
+      auto wbc = std::make_unique<Replay>(s);
+      for (const bool warm : {true, false}) {
+        hqp::loadInstance(in, *wbc, warm);
+        wbc->solve();
+        const auto& r = wbc->result();
+        for (int p = 0; p < Replay::num_levels; ++p)
+          EXPECT_EQ(r.levels[p].status, hqp::QpStatus::Optimal) << k << " level " << p << " warm " << warm;
+        const Replay::VectorX& x = r.x;
+        for (int i = 0; i < Replay::total_constraint_rows; ++i) {
+          const double d = in.D.row(i).dot(x);
+          const double tol = 1e-9 * (1.0 + std::abs(d));
+          EXPECT_GE(d, in.lower(i) - tol) << k << " row " << i;
+          EXPECT_LE(d, in.upper(i) + tol) << k << " row " << i;
+        }
+        const Eigen::VectorXd e = in.A.middleRows(t3, r3) * x - in.b.segment(t3, r3);
+        const double objective = (e.array().square() * in.w.segment(t3, r3).array()).sum();
+        EXPECT_NEAR(objective, optimum[k], 1e-7 * optimum[k]) << k << " defer " << defer << " warm " << warm;
+      }
+    }
+  }
+}
+
 TEST(Recording, FileRoundTripIsExact) {
   const std::string bytes = hqp::problem_file::readWholeFile(HQP_RECORDING_FILE);
   hqp::ProblemFileInfo info;
