@@ -3,6 +3,8 @@
 #   bash scripts/corpus.sh make      # generate into $HQP_BUILD_DIR/corpus (default build/corpus)
 #                                    # from bench/data/corpus.txt, then check it (about 1 min)
 #   bash scripts/corpus.sh check     # exactness only: hqp_corpus check build/corpus
+#   bash scripts/corpus.sh oracle    # every level against an independent optimum (scipy,
+#                                    # tools/hqp_oracle.py; about 1 min)
 #   bash scripts/corpus.sh bench [ARGS]   # BM_Corpus + BM_PeerWarm, pinned, 5 repetitions
 #   bash scripts/corpus.sh compare OLD_BENCH_HQP NEW_BENCH_HQP [ROUNDS]
 #       two bench_hqp binaries (e.g. before and after a change) alternated ROUNDS times
@@ -36,6 +38,17 @@ case $cmd in
   check)
     need hqp_corpus
     exec "$build/tools/hqp_corpus" check "$out" ;;
+  oracle)
+    need hqp_corpus
+    tmp=$(mktemp -d)
+    rc=0
+    for f in walker3_scenarios stress degenerate; do
+      [ -f "$out/$f.hqprec" ] || continue
+      "$build/tools/hqp_corpus" dump "$out/$f.hqprec" "$tmp/$f.json" >/dev/null
+      /usr/bin/python3 "$root/tools/hqp_oracle.py" "$tmp/$f.json" || rc=1
+    done
+    rm -rf "$tmp"
+    exit $rc ;;
   bench)
     need bench_hqp
     [ -f "$out/stress.hqprec" ] || bash "$0" make
@@ -72,7 +85,7 @@ PY
     rm -rf "$tmp"
     exit 0 ;;
   make) ;;
-  *) echo "usage: corpus.sh make|check|bench [ARGS]|compare OLD NEW [ROUNDS]" >&2; exit 2 ;;
+  *) echo "usage: corpus.sh make|check|oracle|bench [ARGS]|compare OLD NEW [ROUNDS]" >&2; exit 2 ;;
 esac
 need sim_demo hqp_corpus
 mkdir -p "$out/scenarios"

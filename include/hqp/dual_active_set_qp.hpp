@@ -206,7 +206,8 @@ class DualActiveSetQp {
         // that span is at most √ε of it: a step along so small a z adds a row nearly dependent
         // on the active ones, whose multipliers (~1/σ_min) are then noise. A bound of 1e-12
         // instead of √ε let multipliers of 1e16 through, and an "Optimal" 4.9 times above
-        // the optimum on a stress instance of the corpus (docs/hqp.md, "Last level").
+        // the optimum on a stress instance (docs/benchmarks.md, "The last level on nearly
+        // dependent rows").
         constexpr double kDependent = std::numeric_limits<double>::epsilon();
         const bool primal = dz2 > kDependent * d_.head(n).squaredNorm() && dz2 > 0.0;
         const double t2 = primal ? -s / dz2 : kInf;
