@@ -439,8 +439,9 @@ int showCommand(const std::string& file, int k) {
                   p + 1, hqp::toString(l.status), f[p], hqp::toString(in.result.levels[p].status), l.iterations,
                   l.num_active, l.rank, l.null_dim, l.dual ? 1 : 0);
       if (l.kkt.computed)
-        std::printf("           KKT: stationarity %.3g (scale %.3g), primal %.3g, dual %.3g, complementarity %.3g\n",
-                    l.kkt.stationarity, l.kkt.stationarity_scale, l.kkt.primal, l.kkt.dual, l.kkt.complementarity);
+        std::printf("           KKT: stationarity %.3g (scale %.3g, gradient %.3g), primal %.3g, dual %.3g, complementarity %.3g\n",
+                    l.kkt.stationarity, l.kkt.stationarity_scale, l.kkt.gradient_scale, l.kkt.primal, l.kkt.dual,
+                    l.kkt.complementarity);
     }
   }
   std::printf("|x_warm - x_cold|_inf = %.3g\n", (x[1] - x[0]).lpNorm<Eigen::Infinity>());

@@ -85,6 +85,10 @@ struct HqpKkt {
   // Stationarity ‖Âᵀ(Â u* − b̂) + Σ_a λ_a (D_a Z)ᵀ‖_∞, i.e. ‖Zᵀ(A_pᵀ W (A_p x*_p − b_p) + D_Wᵀ λ)‖_∞.
   double stationarity = 0.0;
   double stationarity_scale = 0.0;  // ‖Â‖_F ‖Â u* − b̂‖ + Σ_a |λ_a| ‖D_a Z‖: size of its terms
+  // ‖Â‖_F (‖Â u*‖ + ‖b̂‖), the size of the gradient's own terms: unlike stationarity_scale
+  // it does not grow with the multipliers, which a nearly dependent working set blows up
+  // (docs/hqp.md, "Certificate").
+  double gradient_scale = 0.0;
   double primal = 0.0;           // max over rows of levels ≤ p of the bound violation at x*_p / ‖D_i‖
   double dual = 0.0;             // max over active rows of the wrong-signed part of λ_a, times ‖D_a‖
   double complementarity = 0.0;  // max over active rows of |λ_a (D_a x*_p − its bound)|
@@ -953,7 +957,9 @@ class HqpWbc {
     kkt_e_.noalias() = A * u;
     kkt_e_ -= b;
     kkt_s_.noalias() = A.transpose() * kkt_e_;
-    double scale = A.norm() * kkt_e_.norm();
+    const double a_norm = A.norm();
+    double scale = a_norm * kkt_e_.norm();
+    lr.kkt.gradient_scale = a_norm * ((kkt_e_ + b).norm() + b.norm());
     for (int a = 0; a < lr.num_active; ++a) {
       const double l = lr.multiplier[static_cast<std::size_t>(a)];
       const auto c = C.row(lr.active_row[static_cast<std::size_t>(a)]);
