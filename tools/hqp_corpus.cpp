@@ -455,16 +455,6 @@ int showCommand(const std::string& file, int k) {
   return 0;
 }
 
-nlohmann::json rowsJson(const Eigen::Ref<const Eigen::MatrixXd>& m) {
-  nlohmann::json rows = nlohmann::json::array();
-  for (Eigen::Index i = 0; i < m.rows(); ++i) {
-    nlohmann::json row = nlohmann::json::array();
-    for (Eigen::Index j = 0; j < m.cols(); ++j) row.push_back(m(i, j));
-    rows.push_back(row);
-  }
-  return rows;
-}
-
 nlohmann::json vectorJson(const Eigen::Ref<const Eigen::VectorXd>& v) {
   nlohmann::json out = nlohmann::json::array();
   for (Eigen::Index i = 0; i < v.size(); ++i) {
@@ -472,6 +462,12 @@ nlohmann::json vectorJson(const Eigen::Ref<const Eigen::VectorXd>& v) {
     else out.push_back(nullptr);  // ±inf: no bound (the side tells which)
   }
   return out;
+}
+
+nlohmann::json rowsJson(const Eigen::Ref<const Eigen::MatrixXd>& m) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < m.rows(); ++i) rows.push_back(vectorJson(m.row(i).transpose()));
+  return rows;
 }
 
 int dumpCommand(const std::string& file, const std::string& out_path) {
