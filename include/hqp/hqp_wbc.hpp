@@ -651,6 +651,9 @@ class HqpWbc {
       if (settings_.dual_last_level && r >= n && dualLastLevel<P>(n, col0, scale, lr)) return;
       if (aborted_) return;  // the deferred path's QP failed: no second try here
     }
+    if constexpr (last) {
+      if (deferred_) deferredConstraintRows(n);  // the general path reads them
+    }
     auto& ns = ns_[P];
     ns.compute(M_, settings_.rank_tol * scale);
     const int k = ns.rank();
@@ -816,7 +819,6 @@ class HqpWbc {
   bool dualLastLevel(int n, int col0, double scale, HqpLevelResult<max_active>& lr) {
     constexpr int r = LevelType<P>::task_rows;
     constexpr int t0 = task_offset[P];
-    constexpr int c0 = constraint_offset[P];
     constexpr int c = constraint_offset[P + 1];
     bq_ = bt_.template segment<r>(t0);
     bq_.array() *= w_.template segment<r>(t0).array().sqrt();
@@ -826,6 +828,42 @@ class HqpWbc {
     // deferred path a failure below means a row holds some higher level away from its minimum
     // (the cascade decides), not a reason to try the QP again.
     aborted_ = deferred_;
+    const auto Cw = W_.block(total_task_rows, col0, c, n);
+    auto& qp = std::get<P>(qps_);
+    const bool free = deferred_ && deferredFreeStep();
+    if (free) {
+      u_ = dual_.unconstrainedMinimizer();
+      lr.iterations = 0;
+      lr.num_active = 0;
+    } else if (!solveDual<P>(n, col0, min_sigma, lr)) {
+      return false;
+    }
+    aborted_ = false;
+    lr.status = QpStatus::Optimal;
+    lr.dual = true;
+    if (settings_.kkt_residuals) kktStationarity(lr, M_, bq_, u_, Cw);  // Cw: active rows only
+    // The level's ActiveSetQp starts from this active set if a later tick needs it.
+    qp.resize(n, r, 0, c);
+    qp.setWorkingSet(lr.num_active, lr.active_row.data(), lr.active_upper.data());
+    up_[P] = u_;
+    unrotated_[P] = true;
+    const Eigen::Matrix<double, r, 1> e =
+        W_.block(t0, col0, r, n) * u_ - bt_.template segment<r>(t0);
+    n_ = 0;
+    lr.rank = n;
+    rank_[P] = n;
+    finishLevel<P>(lr, e);
+    return true;
+  }
+
+  // dualLastLevel's QP over every constraint row: bounds, then up to three orders of the
+  // dual method. On success u_ and the active set are in lr.
+  template <int P>
+  bool solveDual(int n, int col0, double min_sigma, HqpLevelResult<max_active>& lr) {
+    constexpr int r = LevelType<P>::task_rows;
+    constexpr int c0 = constraint_offset[P];
+    constexpr int c = constraint_offset[P + 1];
+    if (deferred_) deferredConstraintRows(n);
     const auto Cw = W_.block(total_task_rows, col0, c, n);
     cnorm_.head(c) = Cw.rowwise().squaredNorm();
     const int own_begin = ownBegin(c0);
@@ -865,9 +903,6 @@ class HqpWbc {
     }
     if (s != QpStatus::Optimal) return false;
     u_ = dual_.x();
-    aborted_ = false;
-    lr.status = QpStatus::Optimal;
-    lr.dual = true;
     lr.iterations = dual_.iterations();
     lr.num_active = std::min(dual_.numActive(), max_active);
     for (int a = 0; a < lr.num_active; ++a) {
@@ -876,18 +911,6 @@ class HqpWbc {
       lr.active_upper[as] = dual_.activeAtUpper(a);
       lr.multiplier[as] = dual_.activeAtUpper(a) ? dual_.multiplier(a) : -dual_.multiplier(a);
     }
-    if (settings_.kkt_residuals) kktStationarity(lr, M_, bq_, u_, Cw);
-    // The level's ActiveSetQp starts from this active set if a later tick needs it.
-    qp.resize(n, r, 0, c);
-    qp.setWorkingSet(lr.num_active, lr.active_row.data(), lr.active_upper.data());
-    up_[P] = u_;
-    unrotated_[P] = true;
-    const Eigen::Matrix<double, r, 1> e =
-        W_.block(t0, col0, r, n) * u_ - bt_.template segment<r>(t0);
-    n_ = 0;
-    lr.rank = n;
-    rank_[P] = n;
-    finishLevel<P>(lr, e);
     return true;
   }
 
@@ -911,9 +934,10 @@ class HqpWbc {
       ns_[static_cast<std::size_t>(q)].applyQTransposeOnTheRight(cols);
     }
     // The rows from A_p on in W_ are still A_p and D (begin(), only the higher task rows
-    // were rotated): their product with Z, in place into the last n columns.
+    // were rotated): their product with Z, in place into the last n columns. The constraint
+    // rows only if the unconstrained minimizer breaks one (deferredConstraintRows).
     {
-      constexpr int rows = total_task_rows + total_constraint_rows - t0;
+      constexpr int rows = total_task_rows - t0;
       auto Wl = W_.template middleRows<rows>(t0);
       detail::multiplyRowStrips<Nx>(Wl, rows, Nx, Zt_, n);
     }
@@ -921,7 +945,35 @@ class HqpWbc {
     xd_ = x_;
     bt_.template segment<r>(t0) = b_.template segment<r>(t0);
     bt_.template segment<r>(t0).noalias() -= A_.template middleRows<r>(t0) * x_;
-    dx_.template head<c>().noalias() = D_.template topRows<c>() * x_;
+    constraint_rows_pending_ = c > 0;
+  }
+
+  // The deferred path's constraint rows D Z_{p−1} (in place, as deferredRows) and D x*_{p−1}.
+  void deferredConstraintRows(int n) {
+    constexpr int c = total_constraint_rows;
+    if constexpr (c > 0) {
+      if (!constraint_rows_pending_) return;
+      constraint_rows_pending_ = false;
+      auto Wc = W_.template middleRows<c>(total_task_rows);
+      detail::multiplyRowStrips<Nx>(Wc, c, Nx, Zt_, n);
+      dx_.template head<c>().noalias() = D_.template topRows<c>() * xd_;
+    }
+  }
+
+  // The deferred path's last level at the unconstrained minimizer u0 of its objective: if
+  // x = x*_{p−1} + Z_{p−1} u0 meets every bound (exactly, without the QP's tolerance), the
+  // dual method would add no row (it adds one only past feasibility_tol) and end at u0, so
+  // the constraint rows are not formed in u (most warm ticks: no row active at the last level).
+  bool deferredFreeStep() {
+    constexpr int c = total_constraint_rows;
+    x_ = xd_;
+    x_.noalias() += Zt_.transpose() * dual_.unconstrainedMinimizer();
+    if constexpr (c > 0) {
+      kkt_d_.template head<c>().noalias() = D_.template topRows<c>() * x_;
+      for (int i = 0; i < c; ++i)
+        if (!(lower_(i) <= kkt_d_(i) && kkt_d_(i) <= upper_(i))) return false;
+    }
+    return true;
   }
 
   // The deferred path's x = x*_{p−1} + Z_{p−1} u of the last level p (deferredRows' Zᵀ and
@@ -1253,6 +1305,7 @@ class HqpWbc {
   Result result_{};
   bool deferred_ = false;  // solving on the deferred path (HqpSettings::defer_constraints)
   bool aborted_ = false;   // the deferred path failed; the cascade runs
+  bool constraint_rows_pending_ = false;  // deferred: D Z_{p−1} not yet formed (deferredRows)
   bool higher_free_ = true;  // the cascade: no row held a level above the last so far
   VectorM kkt_e_;                // certificate scratch: A u − b
   VectorU kkt_s_;                // its stationarity vector

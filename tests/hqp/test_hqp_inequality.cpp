@@ -6,6 +6,7 @@
 #include <Eigen/Dense>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <random>
 #include <string>
@@ -264,6 +265,51 @@ TEST(HqpInequality, DeferredPathGivesTheCascadesOptimum) {
   EXPECT_GE(deferred, 75);        // all reachable trials, and some of the far ones
   EXPECT_GE(cascade, 40);         // far targets pressed against rows: the cascade ran
   EXPECT_GE(deferred_active, 40); // the last level really held rows of the levels above
+}
+
+// The deferred path's last level when its unconstrained minimizer meets every row: no row is
+// formed in its variables, the level ends with none active (docs/hqp.md, "Deferred
+// constraints"). Every target near a point strictly inside every row (no equality rows), so
+// that the minimizer lands inside, or, for some trials, just outside one row: the same x as
+// the cascade either way, the brute-force residuals, every row held.
+TEST(HqpInequality, DeferredLastLevelFreeStepGivesTheCascadesOptimum) {
+  std::mt19937 g(53);
+  static Wbc on, off;
+  off.setDeferConstraints(false);
+  int free = 0, held = 0;
+  for (int trial = 0; trial < 100; ++trial) {
+    Eigen::VectorXd x0;
+    auto L = makeLevels(0, g, &x0);
+    const double reach = trial % 2 == 0 ? 0.01 : 0.5;  // near x0, or far enough to press a row
+    for (auto& l : L) {
+      const Eigen::VectorXd d0 = l.D * x0;
+      for (int i = 0; i < l.D.rows(); ++i)
+        if (l.lower(i) == l.upper(i)) l.lower(i) = d0(i) - 0.3, l.upper(i) = d0(i) + 0.3;
+    }
+    for (int p = 0; p < 3; ++p) L[static_cast<size_t>(p)].b = L[static_cast<size_t>(p)].A * x0;
+    L[3].b = L[3].A * (x0 + reach * randn(N, 1, g));
+    const auto ref = hqp::testing::bruteForceCascade(L, N);
+    fill(on, L);
+    fill(off, L);
+    on.resetWarmStart();
+    off.resetWarmStart();
+    ASSERT_EQ(on.solve(), hqp::QpStatus::Optimal) << "trial " << trial;
+    ASSERT_EQ(off.solve(), hqp::QpStatus::Optimal) << "trial " << trial;
+    const auto& r = on.result();
+    ASSERT_TRUE(r.deferred) << "trial " << trial;
+    (r.levels[3].num_active == 0 ? free : held) += 1;
+    for (int p = 0; p < 4; ++p) {
+      const double res = ref.residual[static_cast<size_t>(p)];
+      EXPECT_NEAR(r.levels[static_cast<size_t>(p)].residual, res, 1e-8 * (1.0 + res))
+          << "trial " << trial << " level " << p;
+    }
+    EXPECT_LT(maxViolation(L, r.x, std::vector<bool>(4)), 1e-8) << "trial " << trial;
+    const double xs = std::max(1.0, off.result().x.lpNorm<Eigen::Infinity>());
+    EXPECT_LT((r.x - off.result().x).lpNorm<Eigen::Infinity>() / xs, 1e-8) << "trial " << trial;
+  }
+  EXPECT_GE(free, 40);  // the near targets
+  EXPECT_GE(held, 20);  // a row pressed: the dual method over every row
+  std::printf("deferred last level: %d free, %d with rows active\n", free, held);
 }
 
 // When the deferred path is tried (docs/hqp.md): only while no level above the last holds a
