@@ -830,7 +830,10 @@ class HqpWbc {
     aborted_ = deferred_;
     const auto Cw = W_.block(total_task_rows, col0, c, n);
     auto& qp = std::get<P>(qps_);
-    const bool free = deferred_ && deferredFreeStep();
+    // Tried unless the warm start holds rows (then the minimizer most likely breaks one: the
+    // check would only add its products); decided by the working set, so replays stay exact.
+    const bool warm_rows = settings_.warm_start && DualQp::preferredRows(qp, n, prefer_) > 0;
+    const bool free = deferred_ && !warm_rows && deferredFreeStep();
     if (free) {
       u_ = dual_.unconstrainedMinimizer();
       lr.iterations = 0;
