@@ -830,15 +830,15 @@ class HqpWbc {
     aborted_ = deferred_;
     const auto Cw = W_.block(total_task_rows, col0, c, n);
     auto& qp = std::get<P>(qps_);
-    // Tried unless the warm start holds rows (then the minimizer most likely breaks one: the
-    // check would only add its products); decided by the working set, so replays stay exact.
-    const bool warm_rows = settings_.warm_start && DualQp::preferredRows(qp, n, prefer_) > 0;
-    const bool free = deferred_ && !warm_rows && deferredFreeStep();
-    if (free) {
+    const int own = settings_.warm_start ? DualQp::preferredRows(qp, n, prefer_) : 0;
+    // The free step is tried unless the warm start holds rows (then the minimizer most likely
+    // breaks one: the check would only add its products); decided by the working set alone,
+    // so replays stay exact.
+    if (deferred_ && own == 0 && deferredFreeStep()) {
       u_ = dual_.unconstrainedMinimizer();
       lr.iterations = 0;
       lr.num_active = 0;
-    } else if (!solveDual<P>(n, col0, min_sigma, lr)) {
+    } else if (!solveDual<P>(n, col0, min_sigma, own, lr)) {
       return false;
     }
     aborted_ = false;
@@ -860,9 +860,10 @@ class HqpWbc {
   }
 
   // dualLastLevel's QP over every constraint row: bounds, then up to three orders of the
-  // dual method. On success u_ and the active set are in lr.
+  // dual method (the first from the own rows of the warm start in prefer_). On success u_ and
+  // the active set are in lr.
   template <int P>
-  bool solveDual(int n, int col0, double min_sigma, HqpLevelResult<max_active>& lr) {
+  bool solveDual(int n, int col0, double min_sigma, int own, HqpLevelResult<max_active>& lr) {
     constexpr int r = LevelType<P>::task_rows;
     constexpr int c0 = constraint_offset[P];
     constexpr int c = constraint_offset[P + 1];
@@ -890,8 +891,6 @@ class HqpWbc {
     // before the general path: the level's working set first (the previous tick's active set,
     // or a recorded one), then the method's own (most violated first), then, on the cascade,
     // the level above's working set (its rows hold at x*_{p−1}).
-    auto& qp = std::get<P>(qps_);
-    const int own = settings_.warm_start ? DualQp::preferredRows(qp, n, prefer_) : 0;
     QpStatus s = dual_.solve(Cw, dlo_, dup_, c, settings_.qp, prefer_.data(), own);
     if (s == QpStatus::NumericalFailure && own > 0 && dual_.factorize(M_, bq_, r, n, min_sigma))
       s = dual_.solve(Cw, dlo_, dup_, c, settings_.qp);
@@ -969,8 +968,7 @@ class HqpWbc {
   // the constraint rows are not formed in u (most warm ticks: no row active at the last level).
   bool deferredFreeStep() {
     constexpr int c = total_constraint_rows;
-    x_ = xd_;
-    x_.noalias() += Zt_.transpose() * dual_.unconstrainedMinimizer();
+    deferredX(dual_.unconstrainedMinimizer());
     if constexpr (c > 0) {
       kkt_d_.template head<c>().noalias() = D_.template topRows<c>() * x_;
       for (int i = 0; i < c; ++i)
@@ -985,8 +983,12 @@ class HqpWbc {
     constexpr std::size_t L = num_levels - 1;
     q_ = up_[L];
     if (!unrotated_[L]) ns_[L].applyQOnTheLeft(q_);
+    deferredX(q_);
+  }
+  template <class Vec>
+  void deferredX(const Vec& u) {
     x_ = xd_;
-    x_.noalias() += Zt_.transpose() * q_;
+    x_.noalias() += Zt_.transpose() * u;
   }
 
   // e = A_p x*_p − b_p.
