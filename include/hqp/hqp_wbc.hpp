@@ -809,12 +809,14 @@ class HqpWbc {
 
   // The last level when Â_p = M_ has full column rank: min ½‖Â_p u − b̂‖² over the rows of
   // every level, a strictly convex QP in u itself (nothing is below, so no null space and no
-  // rotation), solved by the dual method from the unconstrained minimizer. The bounds are the
-  // ones ActiveSetQp would get (neutralizeLockedRows). Returns false, having changed nothing
-  // the general path reads, if 1/‖R⁻¹‖_F ≤ √r · rank_tol · scale (then NullSpace might find
-  // a rank below n; with σ_min above that bound its pivots all pass, docs/hqp.md) or if the
-  // dual method ends without an optimum (e.g. infeasible own rows: the general path handles
-  // them).
+  // rotation), solved by the dual method from the unconstrained minimizer; on the deferred
+  // path that minimizer is first checked against every row in x (deferredFreeStep), and the
+  // constraint rows are formed in u only if one breaks. The bounds are the ones ActiveSetQp
+  // would get (neutralizeLockedRows). Returns false, having changed nothing the general path
+  // reads but for forming those rows (which it needs too), if 1/‖R⁻¹‖_F ≤ √r · rank_tol · scale
+  // (then NullSpace might find a rank below n; with σ_min above that bound its pivots all
+  // pass, docs/hqp.md) or if the dual method ends without an optimum (e.g. infeasible own
+  // rows: the general path handles them).
   template <int P>
   bool dualLastLevel(int n, int col0, double scale, HqpLevelResult<max_active>& lr) {
     constexpr int r = LevelType<P>::task_rows;
