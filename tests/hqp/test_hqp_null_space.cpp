@@ -82,11 +82,11 @@ TEST(NullSpace, BasisRankProjectorRotatedMatrix) {
   EXPECT_EQ(checked, 200);
 }
 
-// Y Qᵀ by 8-row strips (the reflectors in reverse order, a short last strip in half width)
-// against Eigen's own Householder sequence (a dynamic Y takes that path), for row counts
-// that fill strips, leave 1–4 rows or 5–7 rows over; and the in-place strip product Y Zᵀ
-// against Eigen's product.
-TEST(NullSpace, TransposeOnTheRightAndStripProductMatchEigen) {
+// Y Q and Y Qᵀ by 8-row strips (a last strip of 1–4 rows at its own height) against Eigen's
+// own Householder sequence (a dynamic Y takes that path), for row counts that fill strips,
+// leave 1, 2, 3, 4 or 5–7 rows over; and the in-place strip product Y Zᵀ against Eigen's
+// product.
+TEST(NullSpace, QOnTheRightAndStripProductMatchEigen) {
   std::mt19937 g(11);
   constexpr int MaxR = 12, MaxC = 14, MaxY = 24;
   hqp::NullSpace<MaxR, MaxC> ns;
@@ -103,6 +103,10 @@ TEST(NullSpace, TransposeOnTheRightAndStripProductMatchEigen) {
     Fixed Y = Y0;
     ns.applyQTransposeOnTheRight(Y);
     EXPECT_LT((Y - Y0 * Q.transpose()).norm(), 1e-12 * (1.0 + Y0.norm()))
+        << "trial " << trial << ", " << rows << " rows";
+    Fixed Yq = Y0;
+    ns.applyQOnTheRight(Yq);
+    EXPECT_LT((Yq - Y0 * Q).norm(), 1e-12 * (1.0 + Y0.norm()))
         << "trial " << trial << ", " << rows << " rows";
 
     const int n = 1 + static_cast<int>(g() % c);

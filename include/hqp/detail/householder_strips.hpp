@@ -7,7 +7,9 @@
 // dominated by call overhead, and dot products of one row end in horizontal reductions.
 // Here 8 rows at a time are copied into a local block and every reflector is fixed-size
 // 8-vector FMAs (one AVX-512 register, two AVX2 registers) on L1 data, with four
-// independent accumulators for t = Y v so the sum is not one serial FMA chain.
+// independent accumulators for t = Y v so the sum is not one serial FMA chain. A last strip
+// of 1–4 rows gets a block of its own height (an 8-row block costs as much for 1 row as for
+// 8); each row is summed on its own, so results do not depend on the strip height.
 
 #include <Eigen/Core>
 
@@ -19,10 +21,10 @@ namespace hqp::detail {
 // t = strip v_i for the reflector v_i = [1; V(i+1 : cols, i)] (columns i.. of the strip), in
 // four accumulators: t0 gets column i, then j ≡ i+1 (mod 4) and the tail past the last full
 // group of 4; t1..t3 the others.
-template <int MaxCols, int S, class MatV>
-inline Eigen::Matrix<double, S, 1> stripDot(const Eigen::Matrix<double, S, MaxCols>& strip,
-                                            int cols, const MatV& V, int i) {
-  using Vec = Eigen::Matrix<double, S, 1>;
+template <int MaxCols, class Strip, class MatV>
+inline Eigen::Matrix<double, Strip::RowsAtCompileTime, 1> stripDot(const Strip& strip, int cols,
+                                                                   const MatV& V, int i) {
+  using Vec = Eigen::Matrix<double, Strip::RowsAtCompileTime, 1>;
   Vec t0 = strip.col(i), t1 = Vec::Zero(), t2 = Vec::Zero(), t3 = Vec::Zero();
   int j = i + 1;
   for (; j + 3 < cols; j += 4) {
@@ -35,15 +37,15 @@ inline Eigen::Matrix<double, S, 1> stripDot(const Eigen::Matrix<double, S, MaxCo
   return (t0 + t1) + (t2 + t3);
 }
 
-// strip ← strip H_first ⋯ H_{last−1} on the columns [first, cols) of a local 8-row block.
+// strip ← strip H_first ⋯ H_{last−1} on the columns [first, cols) of a local S-row block.
 // t = strip v of the next reflector is summed while this one updates the columns, so each
 // column is loaded once per reflector; every sum keeps its accumulator and order (t0 gets
 // column i, then j ≡ i+1, and the tail past the last full group of 4; t1..t3 the others),
 // so the result is bit for bit that of a dot pass and an update pass.
-template <int MaxCols, class MatV, class VecTau>
-inline void reflectStrip(Eigen::Matrix<double, 8, MaxCols>& strip, int cols, const MatV& V,
-                         const VecTau& tau, int first, int last) {
-  using Vec = Eigen::Matrix<double, 8, 1>;
+template <int MaxCols, class Strip, class MatV, class VecTau>
+inline void reflectStrip(Strip& strip, int cols, const MatV& V, const VecTau& tau, int first,
+                         int last) {
+  using Vec = Eigen::Matrix<double, Strip::RowsAtCompileTime, 1>;
   int i = first;
   while (i < last && tau(i) == 0.0) ++i;
   if (i >= last) return;
@@ -82,10 +84,10 @@ inline void reflectStrip(Eigen::Matrix<double, 8, MaxCols>& strip, int cols, con
 
 // strip ← strip H_{last−1} ⋯ H_first: the same reflectors in reverse order (Y Qᵀ where the
 // above gives Y Q). One dot pass and one update pass per reflector.
-template <int MaxCols, int S, class MatV, class VecTau>
-inline void reflectStripBackward(Eigen::Matrix<double, S, MaxCols>& strip, int cols,
-                                 const MatV& V, const VecTau& tau, int first, int last) {
-  using Vec = Eigen::Matrix<double, S, 1>;
+template <int MaxCols, class Strip, class MatV, class VecTau>
+inline void reflectStripBackward(Strip& strip, int cols, const MatV& V, const VecTau& tau,
+                                 int first, int last) {
+  using Vec = Eigen::Matrix<double, Strip::RowsAtCompileTime, 1>;
   for (int i = last - 1; i >= first; --i) {
     if (tau(i) == 0.0) continue;
     const Vec t = tau(i) * stripDot<MaxCols>(strip, cols, V, i);
@@ -130,50 +132,50 @@ inline void multiplyRowStrips(MatY&& Y, int rows, int cols, const MatZ& Zt, int 
   }
 }
 
-// Y ← Y H_first ⋯ H_{last−1} (Backward: Y H_{last−1} ⋯ H_first) on rows [0, rows).
+// Rows [r0, r0 + h) of Y (h ≤ S) through the reflectors in a local S-row strip, zero-padded;
+// reflectors first.. touch only columns ≥ first.
+template <int S, int MaxCols, bool Backward, class MatY, class MatV, class VecTau>
+inline void reflectRows(MatY& Y, int r0, int h, int cols, const MatV& V, const VecTau& tau,
+                        int first, int last) {
+  Eigen::Matrix<double, S, MaxCols, S == 1 ? Eigen::RowMajor : Eigen::ColMajor> strip;
+  // Full strips need a Y that can hold S rows (the edge-size QPs have 1-row G).
+  constexpr int MaxRowsY = std::decay_t<MatY>::MaxRowsAtCompileTime;
+  constexpr bool kFull = MaxRowsY == Eigen::Dynamic || MaxRowsY >= S;
+  bool full = false;
+  if constexpr (kFull) full = h == S;
+  if (full) {
+    if constexpr (kFull)
+      for (int j = first; j < cols; ++j) strip.col(j) = Y.col(j).template segment<S>(r0);
+  } else {
+    for (int j = first; j < cols; ++j) {
+      strip.col(j).setZero();
+      strip.col(j).head(h) = Y.col(j).segment(r0, h);
+    }
+  }
+  if constexpr (Backward) reflectStripBackward<MaxCols>(strip, cols, V, tau, first, last);
+  else reflectStrip<MaxCols>(strip, cols, V, tau, first, last);
+  if (full) {
+    if constexpr (kFull)
+      for (int j = first; j < cols; ++j) Y.col(j).template segment<S>(r0) = strip.col(j);
+  } else {
+    for (int j = first; j < cols; ++j) Y.col(j).segment(r0, h) = strip.col(j).head(h);
+  }
+}
+
+// Y ← Y H_first ⋯ H_{last−1} (Backward: Y H_{last−1} ⋯ H_first) on rows [0, rows), 8 rows
+// at a time, a last strip of 1–4 rows at its own height (Walker3: the 9th row of Zᵀ, the 3
+// task rows carried below the second level).
 template <int MaxCols, bool Backward = false, class MatY, class MatV, class VecTau>
 inline void reflectRowStrips(MatY&& Y, int rows, int cols, const MatV& V, const VecTau& tau,
                              int first, int last) {
-  constexpr int S = 8;
-  Eigen::Matrix<double, S, MaxCols> strip;
-  // Full 8-row strips need a Y that can hold 8 rows (the edge-size QPs have 1-row G).
-  constexpr int MaxRowsY = std::decay_t<MatY>::MaxRowsAtCompileTime;
-  constexpr bool kFull = MaxRowsY == Eigen::Dynamic || MaxRowsY >= S;
   if (first >= last || rows <= 0) return;
-  // Reflectors first.. touch only columns ≥ first.
-  for (int r0 = 0; r0 < rows; r0 += S) {
-    const int h = std::min(S, rows - r0);
-    if constexpr (Backward) {
-      if (h <= 4) {  // a short last strip (e.g. 9 rows: 8 + 1) in half the width
-        Eigen::Matrix<double, 4, MaxCols> s4;
-        for (int j = first; j < cols; ++j) {
-          s4.col(j).setZero();
-          s4.col(j).head(h) = Y.col(j).segment(r0, h);
-        }
-        reflectStripBackward<MaxCols>(s4, cols, V, tau, first, last);
-        for (int j = first; j < cols; ++j) Y.col(j).segment(r0, h) = s4.col(j).head(h);
-        continue;
-      }
-    }
-    if constexpr (kFull) {
-      if (h == S)
-        for (int j = first; j < cols; ++j) strip.col(j) = Y.col(j).template segment<S>(r0);
-    }
-    if (!kFull || h < S) {
-      for (int j = first; j < cols; ++j) {
-        strip.col(j).setZero();
-        strip.col(j).head(h) = Y.col(j).segment(r0, h);
-      }
-    }
-    if constexpr (Backward) reflectStripBackward<MaxCols>(strip, cols, V, tau, first, last);
-    else reflectStrip<MaxCols>(strip, cols, V, tau, first, last);
-    if constexpr (kFull) {
-      if (h == S)
-        for (int j = first; j < cols; ++j) Y.col(j).template segment<S>(r0) = strip.col(j);
-    }
-    if (!kFull || h < S) {
-      for (int j = first; j < cols; ++j) Y.col(j).segment(r0, h) = strip.col(j).head(h);
-    }
+  for (int r0 = 0; r0 < rows; r0 += 8) {
+    const int h = std::min(8, rows - r0);
+    if (h == 1) reflectRows<1, MaxCols, Backward>(Y, r0, h, cols, V, tau, first, last);
+    else if (h == 2) reflectRows<2, MaxCols, Backward>(Y, r0, h, cols, V, tau, first, last);
+    else if (h == 3) reflectRows<3, MaxCols, Backward>(Y, r0, h, cols, V, tau, first, last);
+    else if (h == 4) reflectRows<4, MaxCols, Backward>(Y, r0, h, cols, V, tau, first, last);
+    else reflectRows<8, MaxCols, Backward>(Y, r0, h, cols, V, tau, first, last);
   }
 }
 
