@@ -272,9 +272,13 @@ class HqpWbc {
     iterations_used_ = 0;
     result_.cut_level = -1;
     stackAll(std::make_index_sequence<sizeof...(Levels)>{});
+    // Row norms, once per solve: ‖A_i‖² for every level's rank scale and checkHealth, ‖D_i‖.
+    ha_.template head<total_task_rows>() =
+        A_.template topRows<total_task_rows>().rowwise().squaredNorm();
     if constexpr (total_constraint_rows > 0)
       Dnorm_.head(total_constraint_rows) = D_.topRows(total_constraint_rows).rowwise().norm();
-    begin();
+    const bool defer = deferAllowed();
+    begin(defer);
     result_.higher_level_degraded = false;
     result_.deferred = false;
     result_.deferred_tried = false;
@@ -286,7 +290,7 @@ class HqpWbc {
       result_.x = x_;
       return result_.status;
     }
-    if (deferAllowed()) {
+    if (defer) {
       result_.deferred_tried = true;
       deferred_ = true;
       aborted_ = false;
@@ -430,7 +434,6 @@ class HqpWbc {
     // All rows at once (column-major A_: one gemv and a column-wise sum, vectorized).
     he_.template head<T>().noalias() = A_.template topRows<T>() * x_;
     he_.template head<T>() -= b_.template head<T>();
-    ha_.template head<T>() = A_.template topRows<T>().rowwise().squaredNorm();
     double xs = 0.0;  // bound of ‖x*_p‖
     for (int p = 0; p < num_levels; ++p) {
       const std::size_t ps = static_cast<std::size_t>(p);
@@ -460,14 +463,21 @@ class HqpWbc {
     }
   }
 
-  // The state before level 0: Z_{−1} = I, x*_{−1} = 0.
-  void begin() {
+  // The state before level 0: Z_{−1} = I, x*_{−1} = 0. The deferred path copies only the task
+  // rows of the levels above the last (deferredRows forms the others from A_ and D_).
+  void begin(bool deferred = false) {
     result_.status = QpStatus::Optimal;
     result_.failed_level = -1;
     x_.setZero();
     n_ = Nx;
     // Working copy of all rows in the reduced coordinates of the current level (Z_{−1} = I),
     // and the reduced right-hand sides b − A x*, D x* (x*_{−1} = 0).
+    constexpr int higher = task_offset[num_levels - 1];
+    if (deferred) {
+      W_.template topRows<higher>() = A_.template topRows<higher>();
+      bt_.template head<higher>() = b_.template head<higher>();
+      return;
+    }
     W_.template topRows<total_task_rows>() = A_.template topRows<total_task_rows>();
     if constexpr (total_constraint_rows > 0) {
       W_.template middleRows<total_constraint_rows>(total_task_rows) =
@@ -644,9 +654,9 @@ class HqpWbc {
     const auto sw = w_.template segment<r>(t0).cwiseSqrt();
     M_ = W_.block(t0, col0, r, n);
     M_.array().colwise() *= sw.array();
-    const double scale = std::sqrt((A_.template middleRows<r>(t0).rowwise().squaredNorm().array() *
-                                    w_.template segment<r>(t0).array())
-                                       .maxCoeff());
+    const double scale =
+        std::sqrt((ha_.template segment<r>(t0).array() * w_.template segment<r>(t0).array())
+                      .maxCoeff());
     if constexpr (P + 1 == num_levels && c > 0 && !std::is_same_v<DualQp, detail::NoQp>) {
       if (settings_.dual_last_level && r >= n && dualLastLevel<P>(n, col0, scale, lr)) return;
       if (aborted_) return;  // the deferred path's QP failed: no second try here
@@ -937,13 +947,12 @@ class HqpWbc {
       auto cols = Zt_.block(0, Nx - m, n, m);
       ns_[static_cast<std::size_t>(q)].applyQTransposeOnTheRight(cols);
     }
-    // The rows from A_p on in W_ are still A_p and D (begin(), only the higher task rows
-    // were rotated): their product with Z, in place into the last n columns. The constraint
-    // rows only if the unconstrained minimizer breaks one (deferredConstraintRows).
+    // A_p Z into the last n columns of its rows in W_ (begin() copied only the higher task
+    // rows); D Z only if the unconstrained minimizer breaks a row (deferredConstraintRows).
     {
       constexpr int rows = total_task_rows - t0;
-      auto Wl = W_.template middleRows<rows>(t0);
-      detail::multiplyRowStrips<Nx>(Wl, rows, Nx, Zt_, n);
+      detail::multiplyRowStrips<Nx>(A_.template middleRows<rows>(t0),
+                                    W_.template middleRows<rows>(t0), rows, Nx, Zt_, n);
     }
     reconstructX(P);  // x*_{p−1}
     xd_ = x_;
@@ -958,8 +967,8 @@ class HqpWbc {
     if constexpr (c > 0) {
       if (!constraint_rows_pending_) return;
       constraint_rows_pending_ = false;
-      auto Wc = W_.template middleRows<c>(total_task_rows);
-      detail::multiplyRowStrips<Nx>(Wc, c, Nx, Zt_, n);
+      detail::multiplyRowStrips<Nx>(D_.template topRows<c>(),
+                                    W_.template middleRows<c>(total_task_rows), c, Nx, Zt_, n);
       dx_.template head<c>().noalias() = D_.template topRows<c>() * xd_;
     }
   }
@@ -1288,7 +1297,7 @@ class HqpWbc {
   Eigen::Matrix<double, capacity(total_task_rows + total_constraint_rows), 1> tmp_ =
       decltype(tmp_)::Zero();
   VectorC Dnorm_ = VectorC::Zero();  // row norms of D
-  // checkHealth: A x − b and the squared row norms of A.
+  // A x − b (checkHealth) and the squared row norms of A (every level's rank scale too).
   Eigen::Matrix<double, capacity(total_task_rows), 1> he_ = decltype(he_)::Zero(), ha_ = he_;
   VectorC cnorm_ = VectorC::Zero();  // squared row norms of a level's reduced constraint rows
 

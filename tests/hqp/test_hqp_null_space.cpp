@@ -112,9 +112,12 @@ TEST(NullSpace, QOnTheRightAndStripProductMatchEigen) {
     const int n = 1 + static_cast<int>(g() % c);
     const Eigen::MatrixXd Zt = randomMatrix(n, c, g);
     Fixed P = Y0;
-    hqp::detail::multiplyRowStrips<MaxC>(P, rows, c, Zt, n);
+    hqp::detail::multiplyRowStrips<MaxC>(P, P, rows, c, Zt, n);  // in place
     EXPECT_LT((P.rightCols(n) - Y0 * Zt.transpose()).norm(), 1e-12 * (1.0 + Y0.norm() * Zt.norm()))
         << "trial " << trial << ", " << rows << " rows, n = " << n;
+    Fixed O = Fixed::Zero(rows, c);
+    hqp::detail::multiplyRowStrips<MaxC>(Y0, O, rows, c, Zt, n);
+    EXPECT_EQ(O.rightCols(n), P.rightCols(n)) << "out of place, trial " << trial;
   }
 }
 

@@ -96,20 +96,20 @@ inline void reflectStripBackward(Strip& strip, int cols, const MatV& V, const Ve
   }
 }
 
-// Y Zᵀ into the last n of the cols columns of Y, in place, for rows [0, rows) of a
-// column-major Y, with Zt (n x cols, n ≤ cols): 8 rows at a time are copied out, so the
-// product can overwrite the columns it reads.
-template <int MaxCols, class MatY, class MatZ>
-inline void multiplyRowStrips(MatY&& Y, int rows, int cols, const MatZ& Zt, int n) {
+// X Zᵀ into the last n of the cols columns of Y, for rows [0, rows) of column-major X and Y,
+// with Zt (n x cols, n ≤ cols): 8 rows at a time are copied out, so Y may be X (in place).
+template <int MaxCols, class MatX, class MatY, class MatZ>
+inline void multiplyRowStrips(const MatX& X, MatY&& Y, int rows, int cols, const MatZ& Zt,
+                              int n) {
   constexpr int S = 8;
   Eigen::Matrix<double, S, MaxCols> strip, out;
   for (int r0 = 0; r0 < rows; r0 += S) {
     const int h = std::min(S, rows - r0);
     for (int l = 0; l < cols; ++l) {
-      if (h == S) strip.col(l) = Y.col(l).template segment<S>(r0);
+      if (h == S) strip.col(l) = X.col(l).template segment<S>(r0);
       else {
         strip.col(l).setZero();
-        strip.col(l).head(h) = Y.col(l).segment(r0, h);
+        strip.col(l).head(h) = X.col(l).segment(r0, h);
       }
     }
     using Vec = Eigen::Matrix<double, S, 1>;
