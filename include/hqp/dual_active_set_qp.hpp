@@ -96,18 +96,17 @@ class DualActiveSetQp {
         for (int l = i + 1; l < r; ++l) x[l] -= t * v[l];
       }
     }
-    // J = R⁻¹, column j from R x = e_j by columns of R (contiguous).
-    J_.topLeftCorner(n, n).setZero();
-    for (int j = 0; j < n; ++j) {
-      double* x = &J_(0, j);
-      x[j] = 1.0;
-      for (int i = j; i >= 0; --i) {
-        x[i] /= F_(i, i);
-        const double xi = x[i];
-        const double* R = &F_(0, i);
-        for (int l = 0; l < i; ++l) x[l] -= xi * R[l];
-      }
+    // J = R⁻¹ from R J = I, every column at once: row i of J (all columns, padded to whole
+    // vectors) is divided by R_ii, then taken off the rows above. Column j sees the steps of a
+    // back substitution of e_j in the same order (the steps i > j only move zeros), so each
+    // entry is bit for bit that of solving the columns one by one; the lower part is set to 0.
+    Jr_.topRows(n).setZero();
+    for (int i = 0; i < n; ++i) Jr_(i, i) = 1.0;
+    for (int i = n - 1; i >= 0; --i) {
+      Jr_.row(i) /= F_(i, i);
+      for (int l = 0; l < i; ++l) Jr_.row(l) -= F_(l, i) * Jr_.row(i);
     }
+    J_.topLeftCorner(n, n) = Jr_.topLeftCorner(n, n).template triangularView<Eigen::Upper>();
     // ‖R⁻¹‖_F² over the upper triangle (the rest is zero). Summed by hand: GCC's loop analysis
     // of Eigen's block reduction at -O3 warned of an access past a MaxN-column matrix.
     double jn2 = 0.0;
@@ -403,6 +402,7 @@ class DualActiveSetQp {
   Eigen::Matrix<double, MaxRows, MaxN> F_;   // QR of A (R on and above the diagonal)
   Eigen::Matrix<double, MaxRows, 1> c_;  // Q_Aᵀ b
   Eigen::Matrix<double, MaxN, MaxN> J_, Ra_;
+  Eigen::Matrix<double, MaxN, (MaxN + 7) / 8 * 8, Eigen::RowMajor> Jr_;  // factorize(): R⁻¹ by rows
   Eigen::Matrix<double, MaxN, 1> d_, z_, r_, np_, u_;
   Eigen::Matrix<int, MaxN, 1> row_, upper_;
   Eigen::Matrix<double, MaxIneq, 1> cx_, rinv_;

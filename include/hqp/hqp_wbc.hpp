@@ -415,10 +415,18 @@ class HqpWbc {
   // The input contract (docs/hqp.md, "Contracts"): finite A, b, w, D with magnitudes
   // ≤ QpSettings::max_magnitude (NaN and ±inf fail the vectorized |v| ≤ max test), w ≥ 0,
   // bounds NaN-free and ±inf only on their own side. Never NaN out.
+  // It reads the row norms solve() computed first: rows of norm ≤ max / 2 (NaN and ±inf fail
+  // the test) hold only entries ≤ max, so A and D are scanned entry by entry only where some
+  // row is longer (or (max / 2)² overflows).
   bool inputValid() const {
     const double mx = settings_.qp.max_magnitude;
-    if (!detail::withinMagnitude(A_, mx) || !detail::withinMagnitude(b_, mx) ||
-        !detail::withinMagnitude(w_, mx) || !detail::withinMagnitude(D_, mx))
+    const double half = 0.5 * mx, half2 = half * half;
+    constexpr int T = total_task_rows, C = total_constraint_rows;
+    const bool fast = half >= 0.0 && half2 < kInf;
+    const bool a_short = fast && (ha_.template head<T>().array() <= half2).all();
+    const bool d_short = fast && (Dnorm_.template head<C>().array() <= half).all();
+    if ((!a_short && !detail::withinMagnitude(A_, mx)) || !detail::withinMagnitude(b_, mx) ||
+        !detail::withinMagnitude(w_, mx) || (!d_short && !detail::withinMagnitude(D_, mx)))
       return false;
     if (w_.minCoeff() < 0.0) return false;
     for (int r = 0; r < total_constraint_rows; ++r)

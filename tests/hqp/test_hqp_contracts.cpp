@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <string>
 
 #include "hqp/hqp_wbc.hpp"
 #include "hqp/wqp_wbc.hpp"
@@ -221,6 +222,36 @@ TEST(HqpContracts, HealthFlagQuietOnOrdinaryProblems) {
     EXPECT_TRUE(wbc.x().allFinite());
     EXPECT_FALSE(wbc.result().higher_level_degraded) << "instance " << k;
   }
+}
+
+// The magnitude contract is entry-wise at its edge: with max_magnitude = 10, an entry of A or D
+// at 10 is accepted and one a hair above it is InvalidInput (HqpWbc skips the entry-wise scan
+// when every row norm is ≤ 5), with the other rows short or long (4.9s, norm 9.8).
+TEST(HqpContracts, MagnitudeLimitIsEntryWise) {
+  static Wbc wbc(hqp::HqpSettings{hqp::QpSettings{100, 1e-9, 1e-12, 1e-10, 10.0}});
+  const double above = std::nextafter(10.0, 20.0);
+  for (const bool long_rows : {false, true}) {
+    const auto set = [&](double a_entry, double d_entry) {
+      fillBase(wbc);
+      auto& A = wbc.level<3>().task<0>().A;
+      auto& D = wbc.level<3>().constraint<0>().D;
+      if (long_rows) {
+        A.row(1).setConstant(4.9);
+        D.row(0).setConstant(4.9);
+      }
+      A(1, 2) = a_entry;
+      D(0, 1) = d_entry;
+      return wbc.solve();
+    };
+    const std::string rows = long_rows ? "long rows" : "short rows";  // for the messages
+    EXPECT_NE(set(10.0, -10.0), hqp::QpStatus::InvalidInput) << rows;
+    EXPECT_NE(set(-10.0, 10.0), hqp::QpStatus::InvalidInput) << rows;
+    EXPECT_EQ(set(above, 1.0), hqp::QpStatus::InvalidInput) << rows;
+    EXPECT_EQ(set(1.0, -above), hqp::QpStatus::InvalidInput) << rows;
+    EXPECT_TRUE(wbc.x().allFinite());
+  }
+  fillBase(wbc);  // short rows, every entry ≤ 2: valid
+  EXPECT_EQ(wbc.solve(), hqp::QpStatus::Optimal);
 }
 
 // NaN is InvalidInput in both hierarchies (was NumericalFailure), x finite.

@@ -138,27 +138,30 @@ template <int S, int MaxCols, bool Backward, class MatY, class MatV, class VecTa
 inline void reflectRows(MatY& Y, int r0, int h, int cols, const MatV& V, const VecTau& tau,
                         int first, int last) {
   Eigen::Matrix<double, S, MaxCols, S == 1 ? Eigen::RowMajor : Eigen::ColMajor> strip;
-  // Full strips need a Y that can hold S rows (the edge-size QPs have 1-row G).
+  // Fixed-size copies need a Y that can hold S rows (the edge-size QPs have 1-row G).
   constexpr int MaxRowsY = std::decay_t<MatY>::MaxRowsAtCompileTime;
   constexpr bool kFull = MaxRowsY == Eigen::Dynamic || MaxRowsY >= S;
-  bool full = false;
-  if constexpr (kFull) full = h == S;
-  if (full) {
-    if constexpr (kFull)
-      for (int j = first; j < cols; ++j) strip.col(j) = Y.col(j).template segment<S>(r0);
-  } else {
-    for (int j = first; j < cols; ++j) {
-      strip.col(j).setZero();
-      strip.col(j).head(h) = Y.col(j).segment(r0, h);
+  const bool full = kFull && h == S;
+  for (int j = first; j < cols; ++j) {
+    if constexpr (kFull) {
+      if (full) {
+        strip.col(j) = Y.col(j).template segment<S>(r0);
+        continue;
+      }
     }
+    strip.col(j).setZero();
+    strip.col(j).head(h) = Y.col(j).segment(r0, h);
   }
   if constexpr (Backward) reflectStripBackward<MaxCols>(strip, cols, V, tau, first, last);
   else reflectStrip<MaxCols>(strip, cols, V, tau, first, last);
-  if (full) {
-    if constexpr (kFull)
-      for (int j = first; j < cols; ++j) Y.col(j).template segment<S>(r0) = strip.col(j);
-  } else {
-    for (int j = first; j < cols; ++j) Y.col(j).segment(r0, h) = strip.col(j).head(h);
+  for (int j = first; j < cols; ++j) {
+    if constexpr (kFull) {
+      if (full) {
+        Y.col(j).template segment<S>(r0) = strip.col(j);
+        continue;
+      }
+    }
+    Y.col(j).segment(r0, h) = strip.col(j).head(h);
   }
 }
 
