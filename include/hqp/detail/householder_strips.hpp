@@ -96,6 +96,42 @@ inline void reflectStripBackward(Strip& strip, int cols, const MatV& V, const Ve
   }
 }
 
+// Rows [r0, r0 + h) of X, columns [first, cols), into an S-row strip (h ≤ S; zero-padded
+// below h), and back from a strip into Y's columns shifted by `shift`. Fixed-size copies need
+// a matrix that can hold S rows (the edge-size QPs have 1-row G).
+template <class Strip, class MatX>
+inline void loadStrip(Strip& strip, const MatX& X, int r0, int h, int first, int cols) {
+  constexpr int S = Strip::RowsAtCompileTime;
+  constexpr int MaxRowsX = MatX::MaxRowsAtCompileTime;
+  constexpr bool kFull = MaxRowsX == Eigen::Dynamic || MaxRowsX >= S;
+  for (int j = first; j < cols; ++j) {
+    if constexpr (kFull) {
+      if (h == S) {
+        strip.col(j) = X.col(j).template segment<S>(r0);
+        continue;
+      }
+    }
+    strip.col(j).setZero();
+    strip.col(j).head(h) = X.col(j).segment(r0, h);
+  }
+}
+template <class Strip, class MatY>
+inline void storeStrip(const Strip& strip, MatY& Y, int r0, int h, int first, int cols,
+                       int shift = 0) {
+  constexpr int S = Strip::RowsAtCompileTime;
+  constexpr int MaxRowsY = std::decay_t<MatY>::MaxRowsAtCompileTime;
+  constexpr bool kFull = MaxRowsY == Eigen::Dynamic || MaxRowsY >= S;
+  for (int j = first; j < cols; ++j) {
+    if constexpr (kFull) {
+      if (h == S) {
+        Y.col(j + shift).template segment<S>(r0) = strip.col(j);
+        continue;
+      }
+    }
+    Y.col(j + shift).segment(r0, h) = strip.col(j).head(h);
+  }
+}
+
 // X Zᵀ into the last n of the cols columns of Y, for rows [0, rows) of column-major X and Y,
 // with Zt (n x cols, n ≤ cols): 8 rows at a time are copied out, so Y may be X (in place).
 template <int MaxCols, class MatX, class MatY, class MatZ>
@@ -105,13 +141,7 @@ inline void multiplyRowStrips(const MatX& X, MatY&& Y, int rows, int cols, const
   Eigen::Matrix<double, S, MaxCols> strip, out;
   for (int r0 = 0; r0 < rows; r0 += S) {
     const int h = std::min(S, rows - r0);
-    for (int l = 0; l < cols; ++l) {
-      if (h == S) strip.col(l) = X.col(l).template segment<S>(r0);
-      else {
-        strip.col(l).setZero();
-        strip.col(l).head(h) = X.col(l).segment(r0, h);
-      }
-    }
+    loadStrip(strip, X, r0, h, 0, cols);
     using Vec = Eigen::Matrix<double, S, 1>;
     for (int j = 0; j < n; ++j) {  // four independent sums per column of the output
       Vec a0 = Vec::Zero(), a1 = Vec::Zero(), a2 = Vec::Zero(), a3 = Vec::Zero();
@@ -125,10 +155,7 @@ inline void multiplyRowStrips(const MatX& X, MatY&& Y, int rows, int cols, const
       for (; l < cols; ++l) a0.noalias() += Zt(j, l) * strip.col(l);
       out.col(j) = (a0 + a1) + (a2 + a3);
     }
-    for (int j = 0; j < n; ++j) {
-      if (h == S) Y.col(cols - n + j).template segment<S>(r0) = out.col(j);
-      else Y.col(cols - n + j).segment(r0, h) = out.col(j).head(h);
-    }
+    storeStrip(out, Y, r0, h, 0, n, cols - n);
   }
 }
 
@@ -138,31 +165,10 @@ template <int S, int MaxCols, bool Backward, class MatY, class MatV, class VecTa
 inline void reflectRows(MatY& Y, int r0, int h, int cols, const MatV& V, const VecTau& tau,
                         int first, int last) {
   Eigen::Matrix<double, S, MaxCols, S == 1 ? Eigen::RowMajor : Eigen::ColMajor> strip;
-  // Fixed-size copies need a Y that can hold S rows (the edge-size QPs have 1-row G).
-  constexpr int MaxRowsY = std::decay_t<MatY>::MaxRowsAtCompileTime;
-  constexpr bool kFull = MaxRowsY == Eigen::Dynamic || MaxRowsY >= S;
-  const bool full = kFull && h == S;
-  for (int j = first; j < cols; ++j) {
-    if constexpr (kFull) {
-      if (full) {
-        strip.col(j) = Y.col(j).template segment<S>(r0);
-        continue;
-      }
-    }
-    strip.col(j).setZero();
-    strip.col(j).head(h) = Y.col(j).segment(r0, h);
-  }
+  loadStrip(strip, Y, r0, h, first, cols);
   if constexpr (Backward) reflectStripBackward<MaxCols>(strip, cols, V, tau, first, last);
   else reflectStrip<MaxCols>(strip, cols, V, tau, first, last);
-  for (int j = first; j < cols; ++j) {
-    if constexpr (kFull) {
-      if (full) {
-        Y.col(j).template segment<S>(r0) = strip.col(j);
-        continue;
-      }
-    }
-    Y.col(j).segment(r0, h) = strip.col(j).head(h);
-  }
+  storeStrip(strip, Y, r0, h, first, cols);
 }
 
 // Y ← Y H_first ⋯ H_{last−1} (Backward: Y H_{last−1} ⋯ H_first) on rows [0, rows), 8 rows
