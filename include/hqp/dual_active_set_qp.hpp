@@ -18,6 +18,8 @@
 #include <cmath>
 #include <limits>
 
+#include "hqp/detail/nonnegative_least_squares.hpp"
+#include "hqp/detail/qp_min_norm_ls.hpp"
 #include "hqp/qp_settings.hpp"
 #include "hqp/qp_status.hpp"
 
@@ -135,34 +137,10 @@ class DualActiveSetQp {
                  const QpSettings& settings, const int* prefer = nullptr,
                  int prefer_count = 0) noexcept {
     const int n = n_;
-    q_ = 0;
-    held_ = 0;
-    iterations_ = 0;
-    if (!factorized_ || m < 0 || m > MaxIneq) {
-      x_.setZero(n > 0 ? n : 0);
-      return QpStatus::InvalidInput;
-    }
-    x_ = x0_;
-    // Input contract, then empty intervals (scaled like the violations below).
-    if (!detail::withinMagnitude(C.topLeftCorner(m, n), settings.max_magnitude)) {
-      x_.setZero(n);
-      return QpStatus::InvalidInput;
-    }
-    for (int j = 0; j < m; ++j)
-      if (!detail::boundsValid(lower(j), upper(j), settings.max_magnitude)) {
-        x_.setZero(n);
-        return QpStatus::InvalidInput;
-      }
-    for (int j = 0; j < m; ++j) {
-      const double nrm = C.row(j).head(n).norm();
-      rinv_(j) = nrm > 0.0 ? 1.0 / nrm : 1.0;
-      active_(j) = 0;
-      prefer_(j) = 0;
-      if ((lower(j) - upper(j)) * rinv_(j) > settings.feasibility_tol) return QpStatus::Infeasible;
-    }
+    const QpStatus in = start(C, lower, upper, m, settings);
+    if (in != QpStatus::Optimal) return in;
     for (int k = 0; k < prefer_count; ++k)
       if (prefer[k] >= 0 && prefer[k] < m) prefer_(prefer[k]) = 1;
-    m_ = m;
     cx_.head(m).noalias() = C.topLeftCorner(m, n) * x_;
     for (;;) {
       // Step 1: the most violated row side (violation scaled to a unit-norm row).
@@ -240,6 +218,38 @@ class DualActiveSetQp {
     }
   }
 
+  // The same QP by routes that do not depend on an order of the rows, for when solve() ends
+  // on nearly dependent rows (NumericalFailure) in the orders the caller tried. Least distance
+  // (leastDistance below: the NNLS residual that defines its point is stable where the
+  // multipliers are not), and where its point misses the final check, the dual method in the
+  // order of its active set, which is the optimum's in the cases seen (its point can miss by
+  // rounding magnified through R⁻¹). The NNLS threshold for a nearly dependent column is √ε
+  // (a well-conditioned passive set), then 1e-12 (√ε can set aside a row the optimum needs,
+  // left 1e-8 beyond its bound). Statuses and results as solve(); not Optimal means no route
+  // passed the final check (an infeasible problem ends NumericalFailure here).
+  template <class MatC, class VecL, class VecU>
+  QpStatus solveOrderFree(const MatC& C, const VecL& lower, const VecU& upper, int m,
+                          const QpSettings& settings) noexcept {
+    QpStatus s = QpStatus::NumericalFailure;
+    int its = 0;
+    for (const double dependent : {std::sqrt(std::numeric_limits<double>::epsilon()), 1e-12}) {
+      s = leastDistance(C, lower, upper, m, settings, dependent);
+      its += iterations_;
+      if (s == QpStatus::Optimal || s == QpStatus::InvalidInput || q_ == 0) {
+        if (s == QpStatus::Optimal || s == QpStatus::InvalidInput) break;
+        continue;
+      }
+      const int cnt = q_;
+      for (int k = 0; k < cnt; ++k) order_(k) = row_(k);
+      J_.topLeftCorner(n_, n_) = Jr_.topLeftCorner(n_, n_).template triangularView<Eigen::Upper>();
+      s = solve(C, lower, upper, m, settings, order_.data(), cnt);
+      its += iterations_;
+      if (s == QpStatus::Optimal) break;
+    }
+    iterations_ = its;
+    return s;
+  }
+
   // Warm start from a primal solver's working set (ActiveSetQp's numActive/activeRow,
   // variables/hasWorkingSet): if it belongs to a problem of n variables, its first rows (at
   // most MaxN) are written to rows, to be passed to solve() as prefer. Returns their count.
@@ -265,6 +275,120 @@ class DualActiveSetQp {
  private:
   static constexpr double kInf = std::numeric_limits<double>::infinity();
   static double hyp(double a, double b) { return std::sqrt(a * a + b * b); }
+
+  // Common start of solve() and leastDistance(): x at the unconstrained minimizer, no
+  // active row; the input contract, then empty intervals (scaled to unit rows, as every
+  // violation). Optimal means "go on".
+  template <class MatC, class VecL, class VecU>
+  QpStatus start(const MatC& C, const VecL& lower, const VecU& upper, int m,
+                 const QpSettings& settings) {
+    const int n = n_;
+    q_ = 0;
+    held_ = 0;
+    iterations_ = 0;
+    if (!factorized_ || m < 0 || m > MaxIneq) {
+      x_.setZero(n > 0 ? n : 0);
+      return QpStatus::InvalidInput;
+    }
+    x_ = x0_;
+    if (!detail::withinMagnitude(C.topLeftCorner(m, n), settings.max_magnitude)) {
+      x_.setZero(n);
+      return QpStatus::InvalidInput;
+    }
+    for (int j = 0; j < m; ++j)
+      if (!detail::boundsValid(lower(j), upper(j), settings.max_magnitude)) {
+        x_.setZero(n);
+        return QpStatus::InvalidInput;
+      }
+    for (int j = 0; j < m; ++j) {
+      const double nrm = C.row(j).head(n).norm();
+      rinv_(j) = nrm > 0.0 ? 1.0 / nrm : 1.0;
+      active_(j) = 0;
+      prefer_(j) = 0;
+      if ((lower(j) - upper(j)) * rinv_(j) > settings.feasibility_tol) return QpStatus::Infeasible;
+    }
+    m_ = m;
+    return QpStatus::Optimal;
+  }
+
+  // One least-distance solve for solveOrderFree(): least distance programming (Lawson and Hanson, 1974, ch. 23). With w = R (x − x0) the objective is
+  // ½‖w‖² + const and each finite row side a half-space ĝᵀw ≥ ĥ (ĝ = ±R⁻ᵀcᵀ scaled to unit
+  // norm); the optimum is the point of their intersection nearest to 0, w = −r(0:n) / r(n) from
+  // the residual r = f − E μ of the non-negative least squares with E = [Ĝᵀ; ĥᵀ], f = e_n
+  // (r(n) = 0: infeasible). That residual is unique and stable where the multipliers are not,
+  // which is where the dual method's choices turn to noise. `dependent`: the NNLS threshold
+  // for a nearly dependent column. Ends with verified(), as solve().
+  template <class MatC, class VecL, class VecU>
+  QpStatus leastDistance(const MatC& C, const VecL& lower, const VecU& upper, int m,
+                         const QpSettings& settings, double dependent) {
+    const int n = n_;
+    const QpStatus in = start(C, lower, upper, m, settings);
+    if (in != QpStatus::Optimal) return in;
+    auto& E = ldp_.E();
+    const auto Rinv = Jr_.topLeftCorner(n, n);  // upper triangular, zero below (factorize)
+    int cols = 0;
+    for (int j = 0; j < m; ++j) {
+      np_.head(n).noalias() = Rinv.transpose() * C.row(j).head(n).transpose();  // R⁻ᵀ cᵀ
+      const double gn = np_.head(n).norm(), cx0 = C.row(j).head(n).dot(x0_);
+      for (int side = 0; side < 2; ++side) {
+        const bool up = side == 1;
+        const double bound = up ? upper(j) : lower(j);
+        if (!(std::abs(bound) < kInf)) continue;
+        const double sgn = up ? -1.0 : 1.0, h = sgn * (bound - cx0);
+        if (!(gn > 0.0)) {  // a zero row: 0 ≥ h must hold
+          if (h * rinv_(j) > settings.feasibility_tol) return QpStatus::Infeasible;
+          continue;
+        }
+        E.col(cols).head(n) = (sgn / gn) * np_.head(n);
+        E(n, cols) = h / gn;
+        ldp_scale_(cols) = gn;
+        ldp_row_(cols) = up ? -1 - j : j;
+        ++cols;
+      }
+    }
+    ldp_.f().head(n + 1).setZero();
+    ldp_.f()(n) = 1.0;
+    const bool done = ldp_.solve(n + 1, cols, settings.max_iterations, dependent);
+    iterations_ = ldp_.iterations();
+    if (!done) return iterations_ >= settings.max_iterations ? QpStatus::IterationLimit
+                                                            : QpStatus::NumericalFailure;
+    const auto& r = ldp_.residual();
+    // r(n) = 1 − ĥᵀμ: 0 when f lies in the cone (no feasible point); at rounding level the
+    // distance cannot be trusted either way, and the caller's general path decides.
+    if (!(r(n) > std::sqrt(std::numeric_limits<double>::epsilon())))
+      return QpStatus::NumericalFailure;
+    z_.head(n) = -r.head(n) / r(n);  // w
+    x_ = x0_;
+    x_.noalias() += Rinv * z_.head(n);
+    // The passive columns are the active row sides: w = Ĝᵀμ / r(n), so ĝ's multiplier is
+    // μ / r(n), the row's that divided by gn (the row was divided by it).
+    for (int k = 0; k < ldp_.numPassive() && q_ < MaxN; ++k) {
+      const int col = ldp_.passive(k), code = ldp_row_(col);
+      const int j = code < 0 ? -1 - code : code;
+      row_(q_) = j;
+      upper_(q_) = code < 0 ? 1 : 0;
+      u_(q_) = ldp_.mu()(col) / r(n) / ldp_scale_(col);
+      active_(j) = 1;
+      ++q_;
+    }
+    // Refinement on the active rows: w's rounding, magnified by R⁻¹, leaves them off their
+    // bounds by up to ε ‖w‖ ‖R⁻ᵀcᵀ‖ / ‖c‖ (3e-8 per unit row on a stress instance). Their
+    // residuals e, computed in x, are taken out by the smallest correction in w (ĝ_Aᵀ δw
+    // = e / ‖R⁻ᵀcᵀ‖, x += R⁻¹ δw), which keeps the multipliers' stationarity. Two passes.
+    for (int pass = 0; pass < 2 && q_ > 0; ++pass) {
+      for (int k = 0; k < q_; ++k) {
+        const int col = ldp_.passive(k), j = row_(k);
+        const double bound = upper_(k) ? upper(j) : lower(j);
+        refine_M_.row(k).head(n) = E.col(col).head(n).transpose();
+        refine_e_(k) = (upper_(k) ? -1.0 : 1.0) * (bound - C.row(j).head(n).dot(x_)) /
+                       ldp_scale_(col);
+      }
+      detail::qpMinNormLeastSquares<MaxN, MaxN>(refine_M_, q_, n, refine_e_, z_, 1e-12,
+                                                refine_ws_);
+      x_.noalias() += Rinv * z_.head(n);
+    }
+    return verified(C, lower, upper, m, settings);
+  }
 
   // Rotation (a, b) → (ρ, 0) applied to columns i, i + 1 of J: J ← J Gᵀ.
   void rotateJ(int i, double c, double s) {
@@ -408,6 +532,13 @@ class DualActiveSetQp {
   Eigen::Matrix<double, MaxIneq, 1> cx_, rinv_;
   Eigen::Matrix<int, MaxIneq, 1> active_, prefer_;
   VectorX x0_, x_;
+  detail::NonNegativeLeastSquares<MaxN + 1, 2 * MaxIneq> ldp_;  // leastDistance()
+  Eigen::Matrix<double, 2 * MaxIneq, 1> ldp_scale_;  // its columns: the row's ‖R⁻ᵀcᵀ‖
+  Eigen::Matrix<int, 2 * MaxIneq, 1> ldp_row_;       // row j at lower: j, at upper: −1 − j
+  Eigen::Matrix<double, MaxN, MaxN> refine_M_;       // its refinement: the active ĝ rows
+  Eigen::Matrix<double, MaxN, 1> refine_e_;
+  Eigen::Matrix<int, MaxN, 1> order_;                // solveOrderFree(): the dual method's order
+  detail::QpMinNormWorkspace<MaxN, MaxN> refine_ws_;
 };
 
 }  // namespace hqp

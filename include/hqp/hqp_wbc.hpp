@@ -923,6 +923,11 @@ class HqpWbc {
         s = dual_.solve(Cw, dlo_, dup_, c, settings_.qp, prefer_.data(), cnt);
       }
     }
+    // Every order ended on nearly dependent rows: the same QP by routes that depend on no
+    // order (DualActiveSetQp::solveOrderFree), before the general path's ActiveSetQp, which
+    // can end on such rows too.
+    if ((s == QpStatus::NumericalFailure || s == QpStatus::IterationLimit) && !deferred_)
+      s = dual_.solveOrderFree(Cw, dlo_, dup_, c, settings_.qp);
     if (s != QpStatus::Optimal) return false;
     u_ = dual_.x();
     lr.iterations = dual_.iterations();
