@@ -373,18 +373,22 @@ class DualActiveSetQp {
     }
     // Refinement on the active rows: w's rounding, magnified by R⁻¹, leaves them off their
     // bounds by up to ε ‖w‖ ‖R⁻ᵀcᵀ‖ / ‖c‖ (3e-8 per unit row on a stress instance). Their
-    // residuals e, computed in x, are taken out by the smallest correction in w (ĝ_Aᵀ δw
-    // = e / ‖R⁻ᵀcᵀ‖, x += R⁻¹ δw), which keeps the multipliers' stationarity. Two passes.
-    for (int pass = 0; pass < 2 && q_ > 0; ++pass) {
+    // residuals e, computed in x, are taken out by the smallest correction in w (Ĝ_A δw = e
+    // scaled as the rows, x += R⁻¹ δw: δw in the span of the active ĝ keeps stationarity).
+    // Twice; not where the active ĝ are dependent to 1e-12. Scratch: Ra_ (Ĝ_Aᵀ and its QR),
+    // np_ (its reflectors), r_ (e), all solve()'s.
+    for (int pass = 0; pass < 2 && q_ > 0 && q_ <= n; ++pass) {
       for (int k = 0; k < q_; ++k) {
         const int col = ldp_.passive(k), j = row_(k);
         const double bound = upper_(k) ? upper(j) : lower(j);
-        refine_M_.row(k).head(n) = E.col(col).head(n).transpose();
-        refine_e_(k) = (upper_(k) ? -1.0 : 1.0) * (bound - C.row(j).head(n).dot(x_)) /
-                       ldp_scale_(col);
+        Ra_.col(k).head(n) = E.col(col).head(n);
+        r_(k) = (upper_(k) ? -1.0 : 1.0) * (bound - C.row(j).head(n).dot(x_)) / ldp_scale_(col);
       }
-      detail::qpMinNormLeastSquares<MaxN, MaxN>(refine_M_, q_, n, refine_e_, z_, 1e-12,
-                                                refine_ws_);
+      if (!detail::qpHouseholderQr(Ra_, n, q_, 1e-12, np_, d_)) break;
+      for (int i = 0; i < q_; ++i)  // δw = Q [R⁻ᵀ e; 0]
+        z_(i) = (r_(i) - Ra_.col(i).head(i).dot(z_.head(i))) / Ra_(i, i);
+      z_.segment(q_, n - q_).setZero();
+      for (int i = q_ - 1; i >= 0; --i) detail::qpApplyReflector(Ra_, i, n, np_(i), z_);
       x_.noalias() += Rinv * z_.head(n);
     }
     return verified(C, lower, upper, m, settings);
@@ -535,10 +539,7 @@ class DualActiveSetQp {
   detail::NonNegativeLeastSquares<MaxN + 1, 2 * MaxIneq> ldp_;  // leastDistance()
   Eigen::Matrix<double, 2 * MaxIneq, 1> ldp_scale_;  // its columns: the row's ‖R⁻ᵀcᵀ‖
   Eigen::Matrix<int, 2 * MaxIneq, 1> ldp_row_;       // row j at lower: j, at upper: −1 − j
-  Eigen::Matrix<double, MaxN, MaxN> refine_M_;       // its refinement: the active ĝ rows
-  Eigen::Matrix<double, MaxN, 1> refine_e_;
   Eigen::Matrix<int, MaxN, 1> order_;                // solveOrderFree(): the dual method's order
-  detail::QpMinNormWorkspace<MaxN, MaxN> refine_ws_;
 };
 
 }  // namespace hqp
