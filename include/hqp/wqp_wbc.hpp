@@ -148,8 +148,8 @@ class WqpWbc {
 
  private:
   // The dual method on the QP's data, warm from the QP's working set (its active set is handed
-  // back as that working set). False: ActiveSetQp decides (rank-deficient rows, infeasible,
-  // iteration cap).
+  // back as that working set), then its order-free route. False: ActiveSetQp decides
+  // (rank-deficient rows, infeasible, iteration cap).
   bool solveDual() {
     if constexpr (std::is_same_v<DualQp, detail::NoQp>) {
       return false;
@@ -158,8 +158,12 @@ class WqpWbc {
                                qp_.settings().rank_tol * qp_.A().norm();
       if (!dual_.factorize(qp_.A(), qp_.b(), total_task_rows, Nx, min_sigma)) return false;
       const int prefer = warm_start_ ? DualQp::preferredRows(qp_, Nx, prefer_) : 0;
-      const QpStatus s = dual_.solve(qp_.C(), qp_.lower(), qp_.upper(), total_constraint_rows,
-                                     qp_.settings(), prefer_.data(), prefer);
+      QpStatus s = dual_.solve(qp_.C(), qp_.lower(), qp_.upper(), total_constraint_rows,
+                               qp_.settings(), prefer_.data(), prefer);
+      // Nearly dependent rows in this order: the routes that depend on none (docs/hqp.md).
+      if (s == QpStatus::NumericalFailure || s == QpStatus::IterationLimit)
+        s = dual_.solveOrderFree(qp_.C(), qp_.lower(), qp_.upper(), total_constraint_rows,
+                                 qp_.settings());
       if (s != QpStatus::Optimal) return false;
       result_.status = s;
       result_.iterations = dual_.iterations();
