@@ -145,6 +145,28 @@ TEST(QpDual, OrderFreeMatchesBruteForce) {
   EXPECT_GT(active, 500);
 }
 
+// The order-free route on the larger problems of LargerProblemsSatisfyKkt (up to 30 variables
+// and 60 rows, ~28 active at n = 30): the KKT conditions computed here, and the same point as
+// the dual method (the optimum is unique).
+TEST(QpDual, OrderFreeLargerProblemsSatisfyKkt) {
+  std::mt19937 rng(78);
+  std::uniform_int_distribution<int> Un(9, 30), Umi(10, 60);
+  LargeQp qp;
+  for (int trial = 0; trial < 300; ++trial) {
+    const int n = Un(rng);
+    const int m = std::min(40, n + 5);
+    const int mi = Umi(rng);
+    auto p = hqp::testing::makeRandomQp(rng, n, m, 0, mi, -1, 0.5);
+    ASSERT_EQ(solve(qp, p), hqp::QpStatus::Optimal) << "trial " << trial;
+    const Eigen::VectorXd x = qp.x();
+    ASSERT_TRUE(qp.factorize(p.A, p.b, m, n, 1e-9));
+    ASSERT_EQ(qp.solveOrderFree(p.C, p.lower, p.upper, mi, hqp::QpSettings{}),
+              hqp::QpStatus::Optimal) << "trial " << trial;
+    EXPECT_LT(kktError(qp, p), 1e-9) << "trial " << trial;
+    EXPECT_LT((qp.x() - x).cwiseAbs().maxCoeff(), 1e-8 * (1.0 + x.cwiseAbs().maxCoeff())) << trial;
+  }
+}
+
 // Rows in near-duplicate pairs (the second a copy of the first turned by 1e-7, its bound moved
 // by as much): thin wedges where the multipliers are ill-determined. The order-free route
 // ends at the enumeration's point, and every row holds to the tolerance. (With only the √ε
