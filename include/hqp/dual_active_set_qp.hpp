@@ -235,12 +235,11 @@ class DualActiveSetQp {
     for (const double dependent : {std::sqrt(std::numeric_limits<double>::epsilon()), 1e-12}) {
       s = leastDistance(C, lower, upper, m, settings, dependent);
       its += iterations_;
-      if (s == QpStatus::Optimal || s == QpStatus::InvalidInput || q_ == 0) {
-        if (s == QpStatus::Optimal || s == QpStatus::InvalidInput) break;
-        continue;
-      }
+      if (s == QpStatus::Optimal || s == QpStatus::InvalidInput) break;
+      if (q_ == 0) continue;
       const int cnt = q_;
       for (int k = 0; k < cnt; ++k) order_(k) = row_(k);
+      // J = R⁻¹ as factorize() left it (the caller's solve() rotated it; F_, Jr_, x0_ hold).
       J_.topLeftCorner(n_, n_) = Jr_.topLeftCorner(n_, n_).template triangularView<Eigen::Upper>();
       s = solve(C, lower, upper, m, settings, order_.data(), cnt);
       its += iterations_;
