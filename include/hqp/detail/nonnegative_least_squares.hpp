@@ -10,12 +10,14 @@
 // rounding); otherwise it is set aside until the passive set changes. So the passive columns
 // stay numerically independent and the least-squares solves on them meaningful.
 // Each least-squares solve is a fresh Householder QR of the passive columns (at most `rows` of
-// them): this runs only on the rare fallback, so it is kept plain.
+// them; qp_min_norm_ls.hpp's kernel): this runs only on the rare fallback, so it is kept plain.
 
 #include <Eigen/Core>
 
 #include <cmath>
 #include <limits>
+
+#include "hqp/detail/qp_min_norm_ls.hpp"
 
 namespace hqp::detail {
 
@@ -117,36 +119,17 @@ class NonNegativeLeastSquares {
 
  private:
   // z = argmin ‖E_P z − f‖ over the passive columns in the order of P_ (Householder QR in W_,
-  // R on and above the diagonal); false if some |R_kk| is 0 or a number is non-finite.
+  // R on and above the diagonal); false if some R_kk is 0 or a number is non-finite.
   bool leastSquares() {
     const int m = rows_, k = np_;
     if (k > m) return false;
     for (int c = 0; c < k; ++c) W_.col(c).head(m) = E_.col(P_(c)).head(m);
     w_.head(m) = f_.head(m);
-    for (int i = 0; i < k; ++i) {
-      const double tail = W_.col(i).segment(i + 1, m - i - 1).squaredNorm();
-      const double a = W_(i, i);
-      if (tail > 0.0) {
-        const double beta = -std::copysign(std::sqrt(a * a + tail), a);
-        // H = I − 2 v vᵀ/‖v‖² with v = x − beta e_i (kept in column i), ‖v‖² = 2 beta (beta − a).
-        W_(i, i) = a - beta;
-        const double inv = 1.0 / (beta * (a - beta));  // −2/‖v‖²
-        for (int c = i + 1; c < k; ++c) {
-          const double s = W_.col(i).segment(i, m - i).dot(W_.col(c).segment(i, m - i)) * inv;
-          W_.col(c).segment(i, m - i) += s * W_.col(i).segment(i, m - i);
-        }
-        const double s = W_.col(i).segment(i, m - i).dot(w_.segment(i, m - i)) * inv;
-        w_.segment(i, m - i) += s * W_.col(i).segment(i, m - i);
-        W_(i, i) = beta;
-      }
-    }
+    if (!qpHouseholderQr(W_, m, k, 0.0, tau_, tau_)) return false;
+    for (int i = 0; i < k; ++i) qpApplyReflector(W_, i, m, tau_(i), w_);
     for (int i = k - 1; i >= 0; --i) {
       double s = w_(i);
       for (int c = i + 1; c < k; ++c) s -= W_(i, c) * z_(c);
-      if (!(W_(i, i) != 0.0)) {
-        z_(i) = 0.0;
-        return false;
-      }
       z_(i) = s / W_(i, i);
     }
     return z_.head(k).allFinite();
@@ -160,7 +143,7 @@ class NonNegativeLeastSquares {
   Eigen::Matrix<int, MaxCols, 1> passive_, aside_;
   Eigen::Matrix<int, MaxP, 1> P_;
   Eigen::Matrix<double, MaxRows, MaxP> W_;
-  Eigen::Matrix<double, MaxP, 1> z_;
+  Eigen::Matrix<double, MaxP, 1> z_, tau_;
 };
 
 }  // namespace hqp::detail
