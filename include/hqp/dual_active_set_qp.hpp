@@ -310,13 +310,14 @@ class DualActiveSetQp {
     return QpStatus::Optimal;
   }
 
-  // One least-distance solve for solveOrderFree(): least distance programming (Lawson and Hanson, 1974, ch. 23). With w = R (x − x0) the objective is
-  // ½‖w‖² + const and each finite row side a half-space ĝᵀw ≥ ĥ (ĝ = ±R⁻ᵀcᵀ scaled to unit
-  // norm); the optimum is the point of their intersection nearest to 0, w = −r(0:n) / r(n) from
-  // the residual r = f − E μ of the non-negative least squares with E = [Ĝᵀ; ĥᵀ], f = e_n
-  // (r(n) = 0: infeasible). That residual is unique and stable where the multipliers are not,
-  // which is where the dual method's choices turn to noise. `dependent`: the NNLS threshold
-  // for a nearly dependent column. Ends with verified(), as solve().
+  // One least-distance solve for solveOrderFree(): least distance programming (Lawson and
+  // Hanson, 1974, ch. 23). With w = R (x − x0) the objective is ½‖w‖² + const and each finite
+  // row side a half-space ĝᵀw ≥ ĥ (ĝ = ±R⁻ᵀcᵀ scaled to unit norm); the optimum is the point
+  // of their intersection nearest to 0, w = −r(0:n) / r(n) from the residual r = f − E μ of
+  // the non-negative least squares with E = [Ĝᵀ; ĥᵀ], f = e_n (r(n) = 0: infeasible). That
+  // residual is unique and stable where the multipliers are not, which is where the dual
+  // method's choices turn to noise. `dependent`: the NNLS threshold for a nearly dependent
+  // column. Ends with verified(), as solve().
   template <class MatC, class VecL, class VecU>
   QpStatus leastDistance(const MatC& C, const VecL& lower, const VecU& upper, int m,
                          const QpSettings& settings, double dependent) {
