@@ -1035,12 +1035,18 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
       cd_.head(mi_).noalias() = Cs_.topLeftCorner(mi_, n_) * d_.head(n_);
       // Phase 1 rows: Ĉx − t ≤ û and Ĉx + t ≥ l̂.
       const double dt = nv_ > n_ ? d_(n_) : 0.0, xt = nv_ > n_ ? xc_(n_) : 0.0;
+      // A direction component ≤ dir_tol is rounding relative to ‖d‖ and ignored (at a
+      // degenerate vertex it would block zero-length steps forever), unless the step would
+      // carry the row past its bound by more than the tolerance: on a nearly singular A Z
+      // the step can be 1e15 long, and then such a component breaks the row by 1e3.
+      const double past = settings_.feasibility_tol;
       for (int j = 0; j < mi_; ++j) {
         if (in_ws_(j) || skip_(j) == kver) continue;
         // upper side: rises toward û
         const double adu = cd_(j) - dt;
-        if (adu > dir_tol && us_(j) < kInf) {
+        if (adu > 0.0 && us_(j) < kInf) {
           double slack = us_(j) - (cx_(j) - xt);
+          if (!(adu > dir_tol) && !(alpha * adu > slack + past)) slack = kInf;  // rounding
           if (slack < 0.0) slack = 0.0;
           if (slack < alpha * adu) {
             alpha = slack / adu;
@@ -1049,8 +1055,9 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
           }
         }
         const double adl = -(cd_(j) + dt);
-        if (adl > dir_tol && ls_(j) > -kInf) {
+        if (adl > 0.0 && ls_(j) > -kInf) {
           double slack = (cx_(j) + xt) - ls_(j);
+          if (!(adl > dir_tol) && !(alpha * adl > slack + past)) slack = kInf;  // rounding
           if (slack < 0.0) slack = 0.0;
           if (slack < alpha * adl) {
             alpha = slack / adl;

@@ -79,6 +79,28 @@ TEST(QpHard, DegeneratePyramidApexMatchesBruteForce) {
   EXPECT_LE((qp.x() - ref.x).norm(), 1e-9);  // strictly convex: unique optimum
 }
 
+// A step 1e6 long (min ½(1e-6 x0 − 1)²) toward a row nearly orthogonal to it
+// (1e-12 x0 + x1 ≤ 5e-7): the row's direction component, 1e-6, is below the ratio test's
+// rounding guard (10 rank_tol ‖d‖ = 1e-5), yet the full step would break the row by 5e-7. It
+// blocks at half the step; the optimum (objective 0) lies on it: x = (1e6, −5e-7).
+TEST(QpHard, LongStepIsBlockedByANearlyOrthogonalRow) {
+  Qp qp;
+  qp.resize(2, 1, 0, 1);
+  qp.A() << 1e-6, 0.0;
+  qp.b() << 1.0;
+  qp.C() << 1e-12, 1.0;
+  qp.lower() << -kInf;
+  qp.upper() << 5e-7;
+  ASSERT_EQ(qp.solve(Eigen::VectorXd::Zero(2).eval(), false), hqp::QpStatus::Optimal)
+      << "NumericalFailure: the full step was taken past the row";
+  EXPECT_LE(violation(qp), 1e-9);
+  EXPECT_NEAR(qp.x()(0), 1e6, 1e-6);
+  EXPECT_NEAR(qp.x()(1), -5e-7, 1e-12);
+  EXPECT_LE(qp.objective(), 1e-20);
+  ASSERT_EQ(qp.numActive(), 1);
+  EXPECT_TRUE(qp.activeAtUpper(0));
+}
+
 TEST(QpHard, RedundantConsistentEqualities) {
   // E = [e1; e1; 2 e1; e1 + e2; e2], consistent: x1 = 1, x2 = -1; min ½‖x‖² ⇒ x = (1, -1, 0).
   hqp::ActiveSetQp<3, 3, 5, 1> qp;
