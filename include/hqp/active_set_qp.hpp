@@ -1040,31 +1040,22 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
       // carry the row past its bound by more than the tolerance: on a nearly singular A Z
       // the step can be 1e15 long, and then such a component breaks the row by 1e3.
       const double past = settings_.feasibility_tol;
+      // Row j's side approached at rate ad > 0 with the given slack to its bound.
+      const auto ratio = [&](int j, double ad, double slack, bool upper) {
+        if (!(ad > dir_tol) && !(alpha * ad > slack + past)) return;  // rounding
+        if (slack < 0.0) slack = 0.0;
+        if (slack < alpha * ad) {
+          alpha = slack / ad;
+          block = j;
+          block_upper = upper;
+        }
+      };
       for (int j = 0; j < mi_; ++j) {
         if (in_ws_(j) || skip_(j) == kver) continue;
-        // upper side: rises toward û
-        const double adu = cd_(j) - dt;
-        if (adu > 0.0 && us_(j) < kInf) {
-          double slack = us_(j) - (cx_(j) - xt);
-          if (!(adu > dir_tol) && !(alpha * adu > slack + past)) slack = kInf;  // rounding
-          if (slack < 0.0) slack = 0.0;
-          if (slack < alpha * adu) {
-            alpha = slack / adu;
-            block = j;
-            block_upper = true;
-          }
-        }
+        const double adu = cd_(j) - dt;  // upper side: rises toward û
+        if (adu > 0.0 && us_(j) < kInf) ratio(j, adu, us_(j) - (cx_(j) - xt), true);
         const double adl = -(cd_(j) + dt);
-        if (adl > 0.0 && ls_(j) > -kInf) {
-          double slack = (cx_(j) + xt) - ls_(j);
-          if (!(adl > dir_tol) && !(alpha * adl > slack + past)) slack = kInf;  // rounding
-          if (slack < 0.0) slack = 0.0;
-          if (slack < alpha * adl) {
-            alpha = slack / adl;
-            block = j;
-            block_upper = false;
-          }
-        }
+        if (adl > 0.0 && ls_(j) > -kInf) ratio(j, adl, (cx_(j) + xt) - ls_(j), false);
       }
     }
     if (dn > 0.0) {
