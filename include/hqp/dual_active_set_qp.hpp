@@ -388,10 +388,7 @@ class DualActiveSetQp {
         r_(k) = (upper_(k) ? -1.0 : 1.0) * (bound - C.row(j).head(n).dot(x_)) / ldp_scale_(col);
       }
       if (!detail::qpHouseholderQr(Ra_, n, q_, 1e-12, np_, d_)) break;
-      for (int i = 0; i < q_; ++i)  // δw = Q [R⁻ᵀ e; 0]
-        z_(i) = (r_(i) - Ra_.col(i).head(i).dot(z_.head(i))) / Ra_(i, i);
-      z_.segment(q_, n - q_).setZero();
-      for (int i = q_ - 1; i >= 0; --i) detail::qpApplyReflector(Ra_, i, n, np_(i), z_);
+      detail::qpMinNormFromTransposedQr(Ra_, n, q_, np_, r_, z_);  // δw = Q [R⁻ᵀ e; 0]
       x_.noalias() += Rinv * z_.head(n);
     }
     return verified(C, lower, upper, m, settings);

@@ -89,6 +89,16 @@ inline void qpApplyReflector(const Mat& X, int i, int rows, double tau, Vec& y) 
   y.segment(i + 1, rows - i - 1) -= s * X.col(i).segment(i + 1, rows - i - 1);
 }
 
+// The minimum-norm solution of M p = r (M: k × c, k ≤ c, full row rank) from the QR of Mᵀ
+// held in T (qpHouseholderQr(T, c, k, ·, tau, ·)): Rᵀ z = r, then p = Q [z; 0] (c entries).
+template <class Mat, class VecTau, class VecR, class VecP>
+inline void qpMinNormFromTransposedQr(const Mat& T, int c, int k, const VecTau& tau,
+                                      const VecR& r, VecP& p) {
+  for (int i = 0; i < k; ++i) p(i) = (r(i) - T.col(i).head(i).dot(p.head(i))) / T(i, i);
+  p.segment(k, c - k).setZero();
+  for (int i = k - 1; i >= 0; --i) qpApplyReflector(T, i, c, tau(i), p);
+}
+
 // Complete orthogonal decomposition path (any rank). M, r overwritten.
 template <int MaxM, int MaxC, class MatM, class VecR, class VecP>
 inline int qpMinNormPivoted(MatM& M, int m, int c, VecR& r, VecP& p, double abs_tol,
@@ -145,11 +155,7 @@ inline int qpMinNormPivoted(MatM& M, int m, int c, VecR& r, VecP& p, double abs_
       ws.T.col(i).segment(i, c - i) = M.row(i).segment(i, c - i).transpose();
     }
     qpHouseholderQr(ws.T, c, rank, -1.0, ws.tau2, ws.work);
-    for (int i = 0; i < rank; ++i) {
-      ws.w(i) = (r(i) - ws.T.col(i).head(i).dot(ws.w.head(i))) / ws.T(i, i);
-    }
-    ws.w.segment(rank, c - rank).setZero();
-    for (int i = rank - 1; i >= 0; --i) qpApplyReflector(ws.T, i, c, ws.tau2(i), ws.w);
+    qpMinNormFromTransposedQr(ws.T, c, rank, ws.tau2, r, ws.w);
   }
   for (int j = 0; j < c; ++j) p(ws.perm(j)) = ws.w(j);
   return rank;
@@ -180,11 +186,7 @@ inline int qpMinNormLeastSquares(MatM& M, int m, int c, VecR& r, VecP& p, double
   } else {
     ws.T.topLeftCorner(c, m) = M.topLeftCorner(m, c).transpose();
     if (qpHouseholderQr(ws.T, c, m, abs_tol, ws.tau2, ws.work)) {
-      for (int i = 0; i < m; ++i) {  // Rᵀ z = r, R = T(0:m, 0:m) upper triangular
-        ws.w(i) = (r(i) - ws.T.col(i).head(i).dot(ws.w.head(i))) / ws.T(i, i);
-      }
-      ws.w.segment(m, c - m).setZero();
-      for (int i = m - 1; i >= 0; --i) qpApplyReflector(ws.T, i, c, ws.tau2(i), ws.w);
+      qpMinNormFromTransposedQr(ws.T, c, m, ws.tau2, r, ws.w);
       p.head(c) = ws.w.head(c);
       return m;
     }
