@@ -689,6 +689,7 @@ class HqpWbc {
     };
     if (!last) rotateBelow();
     bool direct = false;  // the QP below runs in u, not u' (last level only)
+    bool weighted = false;  // the level's residual from Aq_ (deferred path above the last)
     ns.rotatedMatrix(Aq_);  // Â_p Q, truncated to rank k
     bq_ = bt_.template segment<r>(t0);
     bq_.array() *= sw.array();
@@ -712,6 +713,9 @@ class HqpWbc {
       u_.head(k) = ys_.head(k);
       lr.status = QpStatus::Optimal;
       if (settings_.kkt_residuals) kktStationarity(lr, Aq_, bq_, u_, Aq_);  // no active row
+      // Its residual from Â_p Q u' = Aq_ [y; 0] (truncation only drops columns that meet 0s
+      // of u'), unweighted by W^-½ where every weight is positive: no Q u' is formed.
+      weighted = (sw.array() > 0.0).all();
     } else if (std::get<P>(qps_).numActive() == 0 && freeStep<P>(n, k, col0, rotated)) {
       // The unconstrained minimum-norm step meets every row: it is the QP's optimum with
       // an empty working set, so the QP (and the last level's rotation) is skipped. It is
@@ -804,7 +808,7 @@ class HqpWbc {
     if (direct) {  // u_ holds u = Q u'
       q_ = u_;
       ns.applyQTransposeOnTheLeft(u_);
-    } else {
+    } else if (!weighted) {
       q_ = u_;
       ns.applyQOnTheLeft(q_);
     }
@@ -817,8 +821,14 @@ class HqpWbc {
       if (tasks > 0) bt_.segment(t0 + r, tasks) -= tmp_.head(tasks);
       if (carried > tasks) dx_.head(carried - tasks) += tmp_.segment(tasks, carried - tasks);
     }
-    const Eigen::Matrix<double, r, 1> e =
-        W_.block(t0, col0, r, n) * q_ - bt_.template segment<r>(t0);
+    Eigen::Matrix<double, r, 1> e;
+    if (weighted) {
+      e.noalias() = Aq_.leftCols(k) * u_.head(k);
+      e = e.cwiseQuotient(sw) - bt_.template segment<r>(t0);
+    } else {
+      e.noalias() = W_.block(t0, col0, r, n) * q_;
+      e -= bt_.template segment<r>(t0);
+    }
     n_ = n - k;
     lr.rank = k;
     rank_[P] = k;
@@ -952,13 +962,18 @@ class HqpWbc {
     constexpr int t0 = task_offset[P];
     constexpr int c = total_constraint_rows;
     // Zᵀ = E_{p−1}ᵀ Q_{p−1}ᵀ ⋯ E_0ᵀ Q_0ᵀ from the left: [0 I] in the last var_[q] columns,
-    // times Q_qᵀ (n rows instead of every row below, 8 at a time).
-    Zt_.setZero(n, Nx);
-    Zt_.rightCols(n).setIdentity();
+    // times Q_qᵀ (n rows instead of every row below, 8 at a time). Row n carries x*_{p−1}ᵀ =
+    // ((u'_{p−1}ᵀ Q_{p−1}ᵀ E_{p−2}ᵀ + u'_{p−2}ᵀ) Q_{p−2}ᵀ ⋯ + u'_0ᵀ) Q_0ᵀ through the same
+    // passes (reconstructX's sum, one more row of the strips instead of a vector per reflector).
+    Zt_.setZero(n + 1, Nx);
+    Zt_.topRightCorner(n, n).setIdentity();
     for (int q = P - 1; q >= 0; --q) {
-      const int m = var_[static_cast<std::size_t>(q)];
-      auto cols = Zt_.block(0, Nx - m, n, m);
-      ns_[static_cast<std::size_t>(q)].applyQTransposeOnTheRight(cols);
+      const std::size_t qs = static_cast<std::size_t>(q);
+      const int m = var_[qs];
+      if (m == 0) continue;
+      Zt_.row(n).segment(Nx - m, m) += up_[qs].transpose();
+      auto cols = Zt_.block(0, Nx - m, n + 1, m);
+      ns_[qs].applyQTransposeOnTheRight(cols);
     }
     // A_p Z into the last n columns of its rows in W_ (begin() copied only the higher task
     // rows); D Z only if the unconstrained minimizer breaks a row (deferredConstraintRows).
@@ -967,7 +982,7 @@ class HqpWbc {
       detail::multiplyRowStrips<Nx>(A_.template middleRows<rows>(t0),
                                     W_.template middleRows<rows>(t0), rows, Nx, Zt_, n);
     }
-    reconstructX(P);  // x*_{p−1}
+    x_ = Zt_.row(n).transpose();  // x*_{p−1}
     xd_ = x_;
     bt_.template segment<r>(t0) = b_.template segment<r>(t0);
     bt_.template segment<r>(t0).noalias() -= A_.template middleRows<r>(t0) * x_;
@@ -1012,7 +1027,7 @@ class HqpWbc {
   template <class Vec>
   void deferredX(const Vec& u) {
     x_ = xd_;
-    x_.noalias() += Zt_.transpose() * u;
+    x_.noalias() += Zt_.topRows(u.size()).transpose() * u;
   }
 
   // e = A_p x*_p − b_p.
@@ -1321,7 +1336,7 @@ class HqpWbc {
   std::array<int, sizeof...(Levels)> var_{}, rank_{};  // n and k of every level
   std::array<bool, sizeof...(Levels)> unrotated_{};    // u'_p = u_p (dual path: no Q_p)
   VectorU q_, v_;                // Q u' / reconstruction scratch
-  Eigen::Matrix<double, Eigen::Dynamic, Nx, 0, Nx, Nx> Zt_;  // Z_{p−1}ᵀ (deferredRows)
+  Eigen::Matrix<double, Eigen::Dynamic, Nx, 0, Nx + 1, Nx> Zt_;  // Z_{p−1}ᵀ; x*_{p−1}ᵀ below
   VectorX xd_ = VectorX::Zero();  // x*_{p−1} there
   MatrixM M_;                    // Â_p
   MatrixM Aq_;                   // Â_p Q (truncated)

@@ -96,6 +96,34 @@ inline void reflectStripBackward(Strip& strip, int cols, const MatV& V, const Ve
   }
 }
 
+// dst.head(h) = src.segment(r0, h) for h < S as fixed-size copies: GCC turns the dynamic-size
+// copy into `rep movs`, whose start-up costs more than these few elements (a third of the
+// rows-below rotation of level 1, 15 rows = 8 + 7, was spent there).
+template <int S, class Dst, class Src>
+inline void copyHead(Dst&& dst, const Src& src, int r0, int h) {
+  if constexpr (S > 1) {
+    if (h == S - 1) {
+      dst.template head<S - 1>() = src.template segment<S - 1>(r0);
+      return;
+    }
+    copyHead<S - 1>(dst, src, r0, h);
+  } else if (h == 1) {
+    dst(0) = src(r0);
+  }
+}
+template <int S, class Dst, class Src>
+inline void copyInto(Dst&& dst, int r0, const Src& src, int h) {
+  if constexpr (S > 1) {
+    if (h == S - 1) {
+      dst.template segment<S - 1>(r0) = src.template head<S - 1>();
+      return;
+    }
+    copyInto<S - 1>(dst, r0, src, h);
+  } else if (h == 1) {
+    dst(r0) = src(0);
+  }
+}
+
 // Rows [r0, r0 + h) of X, columns [first, cols), into an S-row strip (h ≤ S; zero-padded
 // below h), and back from a strip into Y's columns shifted by `shift`. Fixed-size copies need
 // a matrix that can hold S rows (the edge-size QPs have 1-row G).
@@ -112,7 +140,7 @@ inline void loadStrip(Strip& strip, const MatX& X, int r0, int h, int first, int
       }
     }
     strip.col(j).setZero();
-    strip.col(j).head(h) = X.col(j).segment(r0, h);
+    copyHead<S>(strip.col(j), X.col(j), r0, h);
   }
 }
 template <class Strip, class MatY>
@@ -128,7 +156,7 @@ inline void storeStrip(const Strip& strip, MatY& Y, int r0, int h, int first, in
         continue;
       }
     }
-    Y.col(j + shift).segment(r0, h) = strip.col(j).head(h);
+    copyInto<S>(Y.col(j + shift), r0, strip.col(j), h);
   }
 }
 
