@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "hqp/detail/householder_strips.hpp"
@@ -51,8 +52,14 @@ class NullSpace {
     // LAPACK xGEQP3 safeguard). The pivot's own norm is always recomputed exactly, and when
     // it is at or below the threshold all remaining norms are recomputed before the rank is
     // decided: the stop rule stays exactly "largest remaining norm ≤ threshold".
+    // Columns of qr_ as unaligned maps (the same reductions and updates as the column
+    // blocks, without their construction on every call; dot and norm sum in Eigen's order).
+    using Col = Eigen::Map<Eigen::VectorXd>;
+    double* const a = qr_.data();
+    const Eigen::Index ld = qr_.outerStride();
+    const auto seg = [a, ld](int j, int from, int len) { return Col(a + j * ld + from, len); };
     for (int j = 0; j < rows_; ++j) {
-      cn_(j) = qr_.col(j).squaredNorm();
+      cn_(j) = seg(j, 0, cols_).squaredNorm();
       cref_(j) = cn_(j);
     }
     for (int i = 0; i < kmax; ++i) {
@@ -60,10 +67,10 @@ class NullSpace {
       int jmax = i;
       for (int j = i + 1; j < rows_; ++j)
         if (cn_(j) > cn_(jmax)) jmax = j;
-      double best = qr_.col(jmax).segment(i, len).squaredNorm();
+      double best = seg(jmax, i, len).squaredNorm();
       if (!(std::sqrt(best) > threshold)) {
         for (int j = i; j < rows_; ++j) {
-          const double nj = qr_.col(j).segment(i, len).squaredNorm();
+          const double nj = seg(j, i, len).squaredNorm();
           if (nj > best) {
             best = nj;
             jmax = j;
@@ -72,27 +79,42 @@ class NullSpace {
         if (!(std::sqrt(best) > threshold)) break;  // |R_ii| would be ≤ threshold: rank = i
       }
       if (jmax != i) {
-        qr_.col(i).swap(qr_.col(jmax));
+        std::swap_ranges(a + i * ld, a + i * ld + cols_, a + jmax * ld);
         std::swap(perm_(i), perm_(jmax));
         std::swap(cn_(i), cn_(jmax));
         std::swap(cref_(i), cref_(jmax));
       }
-      double tau = 0.0, beta = 0.0;
-      qr_.col(i).segment(i, len).makeHouseholderInPlace(tau, beta);
-      qr_(i, i) = beta;
+      // H_i with β e₀ = H_i x (Eigen's makeHouseholderInPlace, step for step).
+      double* const c = a + i * ld + i;
+      double tau = 0.0, beta = c[0];
+      if (len > 1) {
+        Col tail(c + 1, len - 1);
+        const double tail2 = tail.squaredNorm();
+        if (tail2 <= std::numeric_limits<double>::min()) {
+          tail.setZero();
+        } else {
+          const double c0 = c[0];
+          beta = std::sqrt(c0 * c0 + tail2);
+          if (c0 >= 0.0) beta = -beta;
+          tail = tail / (c0 - beta);
+          tau = (beta - c0) / beta;
+        }
+      }
+      c[0] = beta;
       tau_(i) = tau;
       // H_i on the remaining columns, one dot + axpy per column: at these sizes (≤ 30 x 15)
       // Eigen's general block update is dominated by its call overhead.
       if (tau != 0.0 && len > 1) {
-        const auto v = qr_.col(i).segment(i + 1, len - 1);
+        const Col v(c + 1, len - 1);
         for (int j = i + 1; j < rows_; ++j) {
-          auto x = qr_.col(j).segment(i, len);
-          const double t = tau * (x(0) + v.dot(x.tail(len - 1)));
-          x(0) -= t;
-          x.tail(len - 1) -= t * v;
-          const double nj = cn_(j) - x(0) * x(0);
+          double* const x = a + j * ld + i;
+          Col xt(x + 1, len - 1);
+          const double t = tau * (x[0] + v.dot(xt));
+          x[0] -= t;
+          xt -= t * v;
+          const double nj = cn_(j) - x[0] * x[0];
           if (nj <= 1e-4 * cref_(j)) {
-            cn_(j) = x.tail(len - 1).squaredNorm();
+            cn_(j) = xt.squaredNorm();
             cref_(j) = cn_(j);
           } else {
             cn_(j) = nj;
@@ -100,7 +122,7 @@ class NullSpace {
         }
       } else {
         for (int j = i + 1; j < rows_; ++j) {
-          const double x0 = qr_(i, j);
+          const double x0 = a[j * ld + i];
           cn_(j) = std::max(cn_(j) - x0 * x0, 0.0);
         }
       }
@@ -197,10 +219,17 @@ class NullSpace {
     const double tau = tau_(i);
     const int len = cols_ - i;
     if (tau == 0.0 || len < 2) return;
-    const auto v = qr_.col(i).segment(i + 1, len - 1);
-    const double t = tau * (y(i) + v.dot(y.segment(i + 1, len - 1)));
-    y(i) -= t;
-    y.segment(i + 1, len - 1) -= t * v;
+    const Eigen::Map<const Eigen::VectorXd> v(qr_.data() + i * qr_.outerStride() + i + 1, len - 1);
+    if constexpr (Vec::InnerStrideAtCompileTime == 1) {  // maps: no block construction
+      Eigen::Map<Eigen::VectorXd> yt(y.data() + i + 1, len - 1);
+      const double t = tau * (y(i) + v.dot(yt));
+      y(i) -= t;
+      yt -= t * v;
+    } else {
+      const double t = tau * (y(i) + v.dot(y.segment(i + 1, len - 1)));
+      y(i) -= t;
+      y.segment(i + 1, len - 1) -= t * v;
+    }
   }
 
   Factor qr_;
