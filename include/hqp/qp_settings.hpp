@@ -34,6 +34,16 @@ bool withinMagnitude(const M& m, double max) {
     unsigned bad = 0;  // NaN fails |v| ≤ max as well
     for (Eigen::Index i = 0; i < size; ++i) bad |= !(std::abs(v[i]) <= max);
     return bad == 0;
+  } else if constexpr ((M::Flags & Eigen::DirectAccessBit) != 0 &&
+                       (M::Flags & Eigen::RowMajorBit) == 0 && M::InnerStrideAtCompileTime == 1) {
+    // A column-major block: the same branch-free pass per column (Eigen's all() stops at the
+    // first failure, one compare and branch per entry).
+    unsigned bad = 0;
+    for (Eigen::Index j = 0; j < m.cols(); ++j) {
+      const double* v = m.data() + j * m.outerStride();
+      for (Eigen::Index i = 0; i < m.rows(); ++i) bad |= !(std::abs(v[i]) <= max);
+    }
+    return bad == 0;
   } else {
     return (m.array().abs() <= max).all();
   }
