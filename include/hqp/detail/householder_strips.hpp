@@ -96,31 +96,19 @@ inline void reflectStripBackward(Strip& strip, int cols, const MatV& V, const Ve
   }
 }
 
-// dst.head(h) = src.segment(r0, h) for h < S as fixed-size copies: GCC turns the dynamic-size
-// copy into `rep movs`, whose start-up costs more than these few elements (a third of the
-// rows-below rotation of level 1, 15 rows = 8 + 7, was spent there).
+// dst.segment(d0, h) = src.segment(s0, h) for h < S as fixed-size copies: GCC turns the
+// dynamic-size copy into `rep movs`, whose start-up costs more than these few elements (a third
+// of the rows-below rotation of level 1, 15 rows = 8 + 7, was spent there).
 template <int S, class Dst, class Src>
-inline void copyHead(Dst&& dst, const Src& src, int r0, int h) {
+inline void copySegment(Dst&& dst, int d0, const Src& src, int s0, int h) {
   if constexpr (S > 1) {
     if (h == S - 1) {
-      dst.template head<S - 1>() = src.template segment<S - 1>(r0);
+      dst.template segment<S - 1>(d0) = src.template segment<S - 1>(s0);
       return;
     }
-    copyHead<S - 1>(dst, src, r0, h);
+    copySegment<S - 1>(dst, d0, src, s0, h);
   } else if (h == 1) {
-    dst(0) = src(r0);
-  }
-}
-template <int S, class Dst, class Src>
-inline void copyInto(Dst&& dst, int r0, const Src& src, int h) {
-  if constexpr (S > 1) {
-    if (h == S - 1) {
-      dst.template segment<S - 1>(r0) = src.template head<S - 1>();
-      return;
-    }
-    copyInto<S - 1>(dst, r0, src, h);
-  } else if (h == 1) {
-    dst(r0) = src(0);
+    dst(d0) = src(s0);
   }
 }
 
@@ -140,7 +128,7 @@ inline void loadStrip(Strip& strip, const MatX& X, int r0, int h, int first, int
       }
     }
     strip.col(j).setZero();
-    copyHead<S>(strip.col(j), X.col(j), r0, h);
+    copySegment<S>(strip.col(j), 0, X.col(j), r0, h);
   }
 }
 template <class Strip, class MatY>
@@ -156,7 +144,7 @@ inline void storeStrip(const Strip& strip, MatY& Y, int r0, int h, int first, in
         continue;
       }
     }
-    copyInto<S>(Y.col(j + shift), r0, strip.col(j), h);
+    copySegment<S>(Y.col(j + shift), r0, strip.col(j), 0, h);
   }
 }
 
