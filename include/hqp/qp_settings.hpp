@@ -23,26 +23,24 @@ struct QpSettings {
 
 namespace detail {
 
-// True if every entry v of m is finite with |v| ≤ max (NaN compares false).
-// Plain matrices in one branch-free pass over the storage, which vectorizes (Eigen's all()
-// tests one entry at a time).
+// Nonzero if some v[0 .. n) is outside |v| ≤ max (NaN fails the test as well). Branch-free,
+// so it vectorizes (Eigen's all() tests one entry at a time and stops at the first failure).
+inline unsigned outsideMagnitude(const double* v, Eigen::Index n, double max) {
+  unsigned bad = 0;
+  for (Eigen::Index i = 0; i < n; ++i) bad |= !(std::abs(v[i]) <= max);
+  return bad;
+}
+
+// True if every entry v of m is finite with |v| ≤ max.
 template <class M>
 bool withinMagnitude(const M& m, double max) {
   if constexpr (std::is_base_of_v<Eigen::PlainObjectBase<M>, M>) {
-    const double* v = m.data();
-    const Eigen::Index size = m.size();
-    unsigned bad = 0;  // NaN fails |v| ≤ max as well
-    for (Eigen::Index i = 0; i < size; ++i) bad |= !(std::abs(v[i]) <= max);
-    return bad == 0;
+    return outsideMagnitude(m.data(), m.size(), max) == 0;  // the whole storage at once
   } else if constexpr ((M::Flags & Eigen::DirectAccessBit) != 0 &&
                        (M::Flags & Eigen::RowMajorBit) == 0 && M::InnerStrideAtCompileTime == 1) {
-    // A column-major block: the same branch-free pass per column (Eigen's all() stops at the
-    // first failure, one compare and branch per entry).
-    unsigned bad = 0;
-    for (Eigen::Index j = 0; j < m.cols(); ++j) {
-      const double* v = m.data() + j * m.outerStride();
-      for (Eigen::Index i = 0; i < m.rows(); ++i) bad |= !(std::abs(v[i]) <= max);
-    }
+    unsigned bad = 0;  // a column-major block (the dual QP's D Z rows): column by column
+    for (Eigen::Index j = 0; j < m.cols(); ++j)
+      bad |= outsideMagnitude(m.data() + j * m.outerStride(), m.rows(), max);
     return bad == 0;
   } else {
     return (m.array().abs() <= max).all();
