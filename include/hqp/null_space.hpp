@@ -17,7 +17,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <utility>
 
 #include "hqp/detail/householder_strips.hpp"
@@ -84,22 +83,9 @@ class NullSpace {
         std::swap(cn_(i), cn_(jmax));
         std::swap(cref_(i), cref_(jmax));
       }
-      // H_i with β e₀ = H_i x (Eigen's makeHouseholderInPlace, step for step).
       double* const c = a + i * ld + i;
-      double tau = 0.0, beta = c[0];
-      if (len > 1) {
-        Col tail(c + 1, len - 1);
-        const double tail2 = tail.squaredNorm();
-        if (tail2 <= std::numeric_limits<double>::min()) {
-          tail.setZero();
-        } else {
-          const double c0 = c[0];
-          beta = std::sqrt(c0 * c0 + tail2);
-          if (c0 >= 0.0) beta = -beta;
-          tail = tail / (c0 - beta);
-          tau = (beta - c0) / beta;
-        }
-      }
+      double tau = 0.0, beta = 0.0;
+      Col(c, len).makeHouseholderInPlace(tau, beta);
       c[0] = beta;
       tau_(i) = tau;
       // H_i on the remaining columns, one dot + axpy per column: at these sizes (≤ 30 x 15)
