@@ -7,6 +7,20 @@ jobs=$(nproc)
 
 bash "$root/scripts/setup.sh" --fuzz
 start=$(date +%s)
+
+# The sanitizer subset (preset asan) and the fuzzers' regression run (docs/development.md)
+# start now, beside the main build, at the lowest priority: they take the CPU time the main
+# build and ctest leave idle (each build ends on a few long units, and ctest's long pole
+# Install.UserProject runs alone on one core for minutes), and wait while those run. Their
+# logs are printed at the end. Each runs in its own process group (setsid), so that a failing
+# main build stops them with their compilers.
+logs=$(mktemp -d)
+setsid nice -n 19 bash "$root/scripts/sanitize.sh" >"$logs/asan.txt" 2>&1 &
+asan_pid=$!
+HQP_FUZZ_BUILD_DIR="${HQP_FUZZ_BUILD_DIR:-$root/build-fuzz}" \
+  setsid nice -n 19 bash "$root/scripts/fuzz.sh" --ci >"$logs/fuzz.txt" 2>&1 &
+fuzz_pid=$!
+trap 'kill -- -$asan_pid -$fuzz_pid 2>/dev/null || true' EXIT
 # Benchmarks are built and run by scripts/bench.sh (-O3 -march=native builds take ~5 of the
 # CI's minutes; docs/development.md "Build and CI cost").
 # The tests are compiled with clang-14 (installed by setup.sh --fuzz): their template-heavy units
@@ -27,31 +41,22 @@ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release \
 cmake --build "$build" -j"$jobs"
 built=$(date +%s)
 
-# Sanitizer subset (preset asan) and the fuzzers' regression run (docs/development.md), side by
-# side: each build ends on one long unit that leaves a core idle. Their logs are printed after.
-logs=$(mktemp -d)
 set +e
-bash "$root/scripts/sanitize.sh" >"$logs/asan.txt" 2>&1 &
-asan_pid=$!
-HQP_FUZZ_BUILD_DIR="${HQP_FUZZ_BUILD_DIR:-$root/build-fuzz}" bash "$root/scripts/fuzz.sh" --ci >"$logs/fuzz.txt" 2>&1 &
-fuzz_pid=$!
+ctest --test-dir "$build" --output-on-failure -j"$jobs" --timeout 900
+status=$?
+tested=$(date +%s)
 wait $asan_pid
 asan=$?
 wait $fuzz_pid
 fuzz=$?
 set -e
+trap - EXIT
+end=$(date +%s)
 cat "$logs/asan.txt" "$logs/fuzz.txt"
 rm -rf "$logs"
-extra=$(date +%s)
-
-set +e
-ctest --test-dir "$build" --output-on-failure -j"$jobs" --timeout 900
-status=$?
-set -e
-end=$(date +%s)
 echo
-echo "== sanitizer tests exit code $asan, fuzz regression exit code $fuzz ($((extra - built)) s) =="
-echo "== test summary: build $((built - start)) s, tests $((end - extra)) s; ctest exit code $status =="
+echo "== sanitizer tests exit code $asan, fuzz regression exit code $fuzz (done $((end - start)) s after the start, $((end - tested)) s after ctest) =="
+echo "== test summary: build $((built - start)) s, tests $((tested - built)) s; ctest exit code $status; total $((end - start)) s =="
 [ $status -ne 0 ] || [ $asan -eq 0 ] || status=1
 [ $status -ne 0 ] || [ $fuzz -eq 0 ] || status=1
 exit $status
