@@ -122,6 +122,21 @@ class DualActiveSetQp {
     return factorized_;
   }
 
+  // The least-distance objective ½‖x‖² (A = I, b = 0) on n variables: what factorize() would
+  // compute for it (R = I, J = I, unconstrained minimizer 0) without its O(n³) steps.
+  bool factorizeIdentity(int n) noexcept {
+    n_ = n;
+    factorized_ = n > 0 && n <= MaxN;
+    if (!factorized_) return false;
+    F_.topLeftCorner(n, n).setIdentity();
+    c_.head(n).setZero();
+    Jr_.topRows(n).setZero();
+    for (int i = 0; i < n; ++i) Jr_(i, i) = 1.0;
+    J_.topLeftCorner(n, n).setIdentity();
+    x0_.setZero(n);
+    return true;
+  }
+
   // Solves with the constraint rows C (m × n, n of factorize()) and their bounds (±inf for an
   // absent side). Status: Optimal (checked: every row holds to feasibility_tol · (1 + |ĉ x|)
   // scaled to a unit row, and the stationarity residual is at rounding level); Infeasible (a

@@ -75,6 +75,13 @@ struct HqpSettings {
   // lost). Not tried with an iteration budget; with a time budget the cascade takes over where a
   // level would be cut.
   bool defer_constraints = true;
+  // Least-distance step (docs/hqp.md, "Least-distance step"): a level above the last whose
+  // unconstrained minimum-norm step breaks a row, and whose QP has no working set to start from,
+  // first looks for the minimum-norm point among its unconstrained minimizers that meets every
+  // row: u' = [y; v], v = argmin ‖v‖ over the rows, a strictly convex least-distance problem
+  // for the dual method. If one exists it is the level's minimum-norm optimum (the level's
+  // objective is at its unconstrained minimum there); if none does, the level's QP runs.
+  bool least_distance_step = true;
 };
 
 // KKT residuals of one level's QP (docs/hqp.md, "Certificate"), in its variables u (x = x*_{p−1}
@@ -113,6 +120,9 @@ struct HqpLevelResult {
   double time_us = 0.0;              // wall time of this level's solve (steady_clock), µs;
                                      // 0 with HqpSettings::time_levels off
   bool dual = false;                 // solved by DualActiveSetQp (HqpSettings::dual_last_level)
+  // At the minimum-norm unconstrained minimizer that meets every row, found by the dual method
+  // without the level's QP (HqpSettings::least_distance_step); iterations are that method's.
+  bool least_distance = false;
   // The level's residual at the final x rose beyond HqpSettings::residual_rise_tol above its
   // value at x*_p: the lower levels degraded it (numerical health, docs/hqp.md).
   bool degraded = false;
@@ -211,12 +221,13 @@ class HqpWbc {
   static constexpr bool has_slack_levels =
       ((Levels::slack && Levels::constraint_rows > 0) || ...);
   static constexpr int max_slack_rows = detail::maxSlackRows<Levels...>();
-  // The last level's dual solver (HqpSettings::dual_last_level): it sees at most as many
-  // variables as the level has task rows.
+  // The dual solver of the last level (HqpSettings::dual_last_level: at most as many variables
+  // as the level has task rows) and of the least-distance step (HqpSettings::least_distance_step:
+  // up to Nx variables): one object, one type.
   static constexpr int last_task_rows = LevelType<sizeof...(Levels) - 1>::task_rows;
   using DualQp = std::conditional_t<
       (total_constraint_rows > 0 && last_task_rows > 0),
-      DualActiveSetQp<std::min(Nx, last_task_rows), last_task_rows, capacity(total_constraint_rows)>,
+      DualActiveSetQp<Nx, std::max(Nx, last_task_rows), capacity(total_constraint_rows)>,
       detail::NoQp>;
   using SlackQp = std::conditional_t<
       has_slack_levels,
@@ -251,6 +262,7 @@ class HqpWbc {
   void setLevelTiming(bool on) { settings_.time_levels = on; }    // HqpSettings::time_levels
   void setKktResiduals(bool on) { settings_.kkt_residuals = on; }  // HqpSettings::kkt_residuals
   void setDeferConstraints(bool on) { settings_.defer_constraints = on; }
+  void setLeastDistanceStep(bool on) { settings_.least_distance_step = on; }
   // Per-solve budget (HqpSettings::budget_us / budget_iterations; ≤ 0 = none).
   void setBudget(double us, int iterations) {
     settings_.budget_us = us;
@@ -716,12 +728,14 @@ class HqpWbc {
       // Its residual from Â_p Q u' = Aq_ [y; 0] (truncation only drops columns that meet 0s
       // of u'), unweighted by W^-½ where every weight is positive: no Q u' is formed.
       weighted = (sw.array() > 0.0).all();
-    } else if (std::get<P>(qps_).numActive() == 0 && freeStep<P>(n, k, col0, rotated)) {
-      // The unconstrained minimum-norm step meets every row: it is the QP's optimum with
-      // an empty working set, so the QP (and the last level's rotation) is skipped. It is
-      // tried when the level's incoming working set is empty (after a free step the working
-      // set is emptied), so the warm state is the working set alone and a recorded instance
-      // replays exactly (docs/recording.md).
+    } else if (std::get<P>(qps_).numActive() == 0 &&
+               freeStep<P>(n, k, col0, rotated, lr)) {
+      // The unconstrained minimum-norm step meets every row, or (least-distance step) some
+      // unconstrained minimizer does: the nearest to 0 is the QP's optimum, with multipliers
+      // 0, so the QP (and the last level's rotation) is skipped. Both are tried when the
+      // level's incoming working set is empty (after either the working set is emptied), so
+      // the warm state is the working set alone and a recorded instance replays exactly
+      // (docs/recording.md).
       std::get<P>(qps_).resetWorkingSet();
       lr.status = QpStatus::Optimal;
       if (settings_.kkt_residuals) kktStationarity(lr, Aq_, bq_, u_, Aq_);  // no active row
@@ -744,7 +758,7 @@ class HqpWbc {
       QpStatus s = QpStatus::Infeasible;
       if (!locked_infeasible) {
         s = qp.solve(hint, settings_.warm_start);  // the hint is used only if feasible
-        lr.iterations = qp.iterations();
+        lr.iterations += qp.iterations();  // after a failed least-distance step's
       }
       if (deferred_ && s != QpStatus::Optimal) {  // some level above is not at its minimum
         aborted_ = true;
@@ -1111,10 +1125,11 @@ class HqpWbc {
   // L = Â_p Q₁ (full column rank k), if it meets every constraint row up to k ≤ p as the QP
   // would check it (rows scaled to unit norm, feasibility_tol; higher rows' bounds widened to
   // contain 0 as in neutralizeLockedRows). A feasible unconstrained minimizer is the
-  // constrained one, and with an empty working set the QP returns exactly this point. Sets
-  // u_ and returns true, or returns false (u_ untouched) and the QP decides.
+  // constrained one, and with an empty working set the QP returns exactly this point. If it
+  // breaks a row, the least-distance step is tried. Sets u_ and returns true, or returns false
+  // (u_ untouched) and the QP decides.
   template <int P>
-  bool freeStep(int n, int k, int col0, bool rotated) {
+  bool freeStep(int n, int k, int col0, bool rotated, HqpLevelResult<max_active>& lr) {
     constexpr int c0 = constraint_offset[P];
     constexpr int c = constraint_offset[P + 1];
     constexpr int rows0 = total_task_rows;  // first constraint row in W_
@@ -1137,11 +1152,56 @@ class HqpWbc {
       const double v = tmp_(i);
       const double viol = std::max(lo - v, v - up);
       // The row's norm only where a bound is crossed (most rows are strictly inside).
-      if (viol > 0.0 && viol * viol > tol2 * Cw.row(i).squaredNorm()) return false;
+      if (viol > 0.0 && viol * viol > tol2 * Cw.row(i).squaredNorm())
+        return leastDistanceStep<P>(n, k, col0, lr);
     }
     u_.setZero(n);
     u_.head(k) = ys_.head(k);
     return true;
+  }
+
+  // After freeStep<P> found that u' = [y; 0] breaks a row (ys_ = y, tmp_ = C₁ y): the minimum-norm
+  // point of the level's unconstrained minimizers {[y; v]} that meets every row of levels ≤ p,
+  //   min ½‖v‖²  s.t.  lower − dx − C₁ y ≤ C₂ v ≤ upper − dx − C₁ y   (C = [C₁ C₂] rotated),
+  // by the dual method from v = 0 (HqpSettings::least_distance_step). A row with no part in
+  // v (locked: the higher levels fix it) must already hold. Above the last level only (its
+  // rows below are rotated); not on the deferred path (its levels check no row). On success
+  // u_ = [y; v], lr.iterations = the dual method's; false (nothing else changed) if no such
+  // point exists or the method does not end Optimal: the level's QP decides.
+  template <int P>
+  bool leastDistanceStep(int n, int k, int col0, HqpLevelResult<max_active>& lr) {
+    if constexpr (P + 1 == num_levels || std::is_same_v<DualQp, detail::NoQp>) {
+      return false;
+    } else {
+      constexpr int c0 = constraint_offset[P];
+      constexpr int c = constraint_offset[P + 1];
+      const int m = n - k;
+      if (!settings_.least_distance_step || deferred_ || m <= 0) return false;
+      const auto Cw = W_.block(total_task_rows, col0, c, n);
+      const auto Cv = Cw.middleCols(k, m);
+      for (int i = 0; i < c; ++i) {
+        double lo = lower_(i) - dx_(i), up = upper_(i) - dx_(i);
+        widenHigherRow(i, ownBegin(c0), lo, up);
+        lo -= tmp_(i);
+        up -= tmp_(i);
+        if (lockedRow(i, Cv.row(i).squaredNorm())) {
+          if (!lockedRowHolds(i, lo, up)) return false;
+          lo = -kInf;
+          up = kInf;
+        }
+        dlo_(i) = lo;
+        dup_(i) = up;
+      }
+      if (!dual_.factorizeIdentity(m)) return false;
+      const QpStatus s = dual_.solve(Cv, dlo_, dup_, c, settings_.qp);
+      lr.iterations = dual_.iterations();
+      if (s != QpStatus::Optimal) return false;
+      u_.setZero(n);
+      u_.head(k) = ys_.head(k);
+      u_.segment(k, m) = dual_.x();
+      lr.least_distance = true;
+      return true;
+    }
   }
 
   // ys_(0:k) = argmin ‖L y − b'‖, L = Â_p Q₁ of full column rank k (NullSpace): the row-space

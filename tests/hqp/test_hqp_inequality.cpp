@@ -467,6 +467,114 @@ TEST(HqpInequality, InfeasibleLevelKeepsHigherLevelsAndReportsIt) {
   }
 }
 
+// Unit vector e_i of R^N as a row.
+Eigen::RowVectorXd unitRow(int i) { return Eigen::RowVectorXd::Unit(N, i); }
+
+// Level 1 (index 0): x0 = 1, x1 = 1 with x2 + x3 ≥ 2. Its unconstrained minimum-norm step
+// (1, 1, 0, …) breaks the row; the least-distance step moves only the free coordinates:
+// argmin ‖(x2, …, x6)‖ s.t. x2 + x3 ≥ 2 is x2 = x3 = 1, one dual iteration. The lower levels
+// have zero tasks and rows far away, so x = (1, 1, 1, 1, 0, 0, 0) — the level QP's minimum-norm
+// optimum, which the QP itself returns with the step turned off.
+std::vector<hqp::testing::RefLevel> leastDistanceLevels(bool consistent) {
+  std::vector<hqp::testing::RefLevel> L(4);
+  for (int p = 0; p < 4; ++p) {
+    auto& l = L[static_cast<size_t>(p)];
+    l.A = Eigen::MatrixXd::Zero(kTaskRows[p], N);
+    l.b = Eigen::VectorXd::Zero(kTaskRows[p]);
+    l.D = Eigen::MatrixXd::Zero(kConRows[p], N);
+    l.lower = Eigen::VectorXd::Constant(kConRows[p], -100.0);
+    l.upper = Eigen::VectorXd::Constant(kConRows[p], 100.0);
+  }
+  L[0].A << unitRow(0), unitRow(1);
+  L[0].b << 1.0, 1.0;
+  if (consistent) {
+    L[0].D << unitRow(2) + unitRow(3), unitRow(2) - unitRow(3);
+    L[0].lower << 2.0, -hqp::kInf;
+    L[0].upper << hqp::kInf, 10.0;
+  } else {
+    // x0 + x1 + x2 ≤ 1 with x2 ≥ 0: no point with x0 = x1 = 1 meets both; the QP's optimum
+    // is x0 = x1 = 0.5, x2 = 0 (residual 0.25 + 0.25).
+    L[0].D << unitRow(0) + unitRow(1) + unitRow(2), unitRow(2);
+    L[0].lower << -hqp::kInf, 0.0;
+    L[0].upper << 1.0, hqp::kInf;
+  }
+  L[1].D << unitRow(4), unitRow(5);
+  L[2].D << unitRow(6);
+  return L;
+}
+
+TEST(HqpInequality, LeastDistanceStepGivesTheLevelsMinimumNormOptimum) {
+  static Wbc with, without;
+  for (Wbc* w : {&with, &without}) {
+    w->setDeferConstraints(false);  // the cascade: level 1 solves with its rows
+    w->setWarmStart(false);
+  }
+  without.setLeastDistanceStep(false);
+  Eigen::Matrix<double, N, 1> expect;
+  expect << 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0;
+  const auto L = leastDistanceLevels(true);
+  fill(with, L);
+  fill(without, L);
+  ASSERT_EQ(with.solve(), hqp::QpStatus::Optimal);
+  ASSERT_EQ(without.solve(), hqp::QpStatus::Optimal);
+  const auto& a = with.result().levels[0];
+  EXPECT_TRUE(a.least_distance);
+  EXPECT_EQ(a.iterations, 1);
+  EXPECT_EQ(a.num_active, 0);  // the row holds with multiplier 0: the level sits at its minimum
+  EXPECT_LT(a.residual, 1e-28);
+  EXPECT_LE((with.result().x - expect).cwiseAbs().maxCoeff(), 1e-14);
+  // The QP reaches the same point by its own route.
+  EXPECT_FALSE(without.result().levels[0].least_distance);
+  EXPECT_GT(without.result().levels[0].iterations, 0);
+  EXPECT_LE((without.result().x - expect).cwiseAbs().maxCoeff(), 1e-14);
+}
+
+TEST(HqpInequality, LeastDistanceStepLeavesAnInconsistentLevelToItsQp) {
+  static Wbc wbc;
+  wbc.setDeferConstraints(false);
+  wbc.setWarmStart(false);
+  fill(wbc, leastDistanceLevels(false));
+  ASSERT_EQ(wbc.solve(), hqp::QpStatus::Optimal);
+  const auto& l = wbc.result().levels[0];
+  EXPECT_FALSE(l.least_distance);
+  EXPECT_NEAR(l.residual, 0.5, 1e-14);
+  Eigen::Matrix<double, N, 1> expect;
+  expect << 0.5, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0;
+  EXPECT_LE((wbc.result().x - expect).cwiseAbs().maxCoeff(), 1e-14);
+}
+
+// On random hierarchies (cascade, cold) the step changes the route, not the answer: the
+// per-level residuals and x agree with the QPs' to rounding, and the brute-force reference.
+TEST(HqpInequality, LeastDistanceStepAgreesWithTheLevelQps) {
+  std::mt19937 g(31);
+  static Wbc with, without;
+  for (Wbc* w : {&with, &without}) {
+    w->setDeferConstraints(false);
+    w->setWarmStart(false);
+  }
+  without.setLeastDistanceStep(false);
+  int steps = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const auto L = makeLevels(trial % 3, g);
+    fill(with, L);
+    fill(without, L);
+    ASSERT_EQ(with.solve(), without.solve()) << "trial " << trial;
+    const auto ref = hqp::testing::bruteForceCascade(L, N);
+    for (int p = 0; p < 4; ++p) {
+      const size_t q = static_cast<size_t>(p);
+      steps += with.result().levels[q].least_distance;
+      EXPECT_FALSE(without.result().levels[q].least_distance);
+      EXPECT_NEAR(with.result().levels[q].residual, without.result().levels[q].residual,
+                  1e-9 * (1.0 + without.result().levels[q].residual)) << "trial " << trial;
+      EXPECT_NEAR(with.result().levels[q].residual, ref.residual[q], 1e-8 * (1.0 + ref.residual[q]))
+          << "trial " << trial << " level " << p;
+    }
+    EXPECT_LE((with.result().x - without.result().x).cwiseAbs().maxCoeff(),
+              1e-8 * (1.0 + without.result().x.cwiseAbs().maxCoeff())) << "trial " << trial;
+  }
+  EXPECT_GE(steps, 50);  // the step was taken, not only tried
+}
+
 TEST(HqpInequality, NanInputNeverGivesNan) {
   std::mt19937 g(8);
   static Wbc wbc;
