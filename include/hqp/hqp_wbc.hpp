@@ -221,13 +221,16 @@ class HqpWbc {
   static constexpr bool has_slack_levels =
       ((Levels::slack && Levels::constraint_rows > 0) || ...);
   static constexpr int max_slack_rows = detail::maxSlackRows<Levels...>();
-  // The dual solver of the last level (HqpSettings::dual_last_level: at most as many variables
-  // as the level has task rows) and of the least-distance step (HqpSettings::least_distance_step:
-  // up to Nx variables): one object, one type.
+  // The last level's dual solver (HqpSettings::dual_last_level): it sees at most as many
+  // variables as the level has task rows. The least-distance step (HqpSettings::
+  // least_distance_step) uses it too, on levels whose null space fits in that size: sized for
+  // Nx instead, its small products leave Eigen's fixed-size paths and the last level's solve
+  // slows by a few per cent, and a second solver type would cost compile time in every unit.
   static constexpr int last_task_rows = LevelType<sizeof...(Levels) - 1>::task_rows;
+  static constexpr int dual_variables = std::min(Nx, last_task_rows);
   using DualQp = std::conditional_t<
       (total_constraint_rows > 0 && last_task_rows > 0),
-      DualActiveSetQp<Nx, std::max(Nx, last_task_rows), capacity(total_constraint_rows)>,
+      DualActiveSetQp<dual_variables, last_task_rows, capacity(total_constraint_rows)>,
       detail::NoQp>;
   using SlackQp = std::conditional_t<
       has_slack_levels,
@@ -1163,7 +1166,8 @@ class HqpWbc {
   // After freeStep<P> found that u' = [y; 0] breaks a row (ys_ = y, tmp_ = C₁ y): the minimum-norm
   // point of the level's unconstrained minimizers {[y; v]} that meets every row of levels ≤ p,
   //   min ½‖v‖²  s.t.  lower − dx − C₁ y ≤ C₂ v ≤ upper − dx − C₁ y   (C = [C₁ C₂] rotated),
-  // by the dual method from v = 0 (HqpSettings::least_distance_step). A row with no part in
+  // by the dual method from v = 0 (HqpSettings::least_distance_step; only if v fits in the
+  // last level's dual solver, n − k ≤ dual_variables). A row with no part in
   // v (locked: the higher levels fix it) must already hold. Above the last level only (its
   // rows below are rotated); not on the deferred path (its levels check no row). On success
   // u_ = [y; v], lr.iterations = the dual method's; false (nothing else changed) if no such
@@ -1176,7 +1180,7 @@ class HqpWbc {
       constexpr int c0 = constraint_offset[P];
       constexpr int c = constraint_offset[P + 1];
       const int m = n - k;
-      if (!settings_.least_distance_step || deferred_ || m <= 0) return false;
+      if (!settings_.least_distance_step || deferred_ || m <= 0 || m > dual_variables) return false;
       const auto Cw = W_.block(total_task_rows, col0, c, n);
       const auto Cv = Cw.middleCols(k, m);
       for (int i = 0; i < c; ++i) {

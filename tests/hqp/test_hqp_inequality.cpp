@@ -470,12 +470,14 @@ TEST(HqpInequality, InfeasibleLevelKeepsHigherLevelsAndReportsIt) {
 // Unit vector e_i of R^N as a row.
 Eigen::RowVectorXd unitRow(int i) { return Eigen::RowVectorXd::Unit(N, i); }
 
-// Level 1 (index 0): x0 = 1, x1 = 1 with x2 + x3 ≥ 2. Its unconstrained minimum-norm step
-// (1, 1, 0, …) breaks the row; the least-distance step moves only the free coordinates:
-// argmin ‖(x2, …, x6)‖ s.t. x2 + x3 ≥ 2 is x2 = x3 = 1, one dual iteration. The lower levels
-// have zero tasks and rows far away, so x = (1, 1, 1, 1, 0, 0, 0) — the level QP's minimum-norm
-// optimum, which the QP itself returns with the step turned off.
-std::vector<hqp::testing::RefLevel> leastDistanceLevels(bool consistent) {
+// Level 1 (index 0) fixes x0 = x1 = 1. Level 2 (index 1): x4 = 1, x5 = 1 with x2 + x3 ≥ 2; its
+// unconstrained minimum-norm step (x2 = x3 = x6 = 0) breaks the row, and its null space
+// (x2, x3, x6) fits the last level's dual solver (3 variables: the last level's task rows).
+// The least-distance step moves only those: argmin ‖(x2, x3, x6)‖ s.t. x2 + x3 ≥ 2 is
+// x2 = x3 = 1, one dual iteration. The lower levels have zero tasks and rows far away, so
+// x = (1, 1, 1, 1, 1, 1, 0): the level QP's minimum-norm optimum, which the QP itself returns
+// with the step turned off.
+std::vector<hqp::testing::RefLevel> leastDistanceLevels(bool reachable) {
   std::vector<hqp::testing::RefLevel> L(4);
   for (int p = 0; p < 4; ++p) {
     auto& l = L[static_cast<size_t>(p)];
@@ -487,18 +489,20 @@ std::vector<hqp::testing::RefLevel> leastDistanceLevels(bool consistent) {
   }
   L[0].A << unitRow(0), unitRow(1);
   L[0].b << 1.0, 1.0;
-  if (consistent) {
-    L[0].D << unitRow(2) + unitRow(3), unitRow(2) - unitRow(3);
-    L[0].lower << 2.0, -hqp::kInf;
-    L[0].upper << hqp::kInf, 10.0;
+  L[0].D << unitRow(0), unitRow(1);
+  L[1].A << unitRow(4), unitRow(5);
+  L[1].b << 1.0, 1.0;
+  if (reachable) {
+    L[1].D << unitRow(2) + unitRow(3), unitRow(2) - unitRow(3);
+    L[1].lower << 2.0, -hqp::kInf;
+    L[1].upper << hqp::kInf, 10.0;
   } else {
-    // x0 + x1 + x2 ≤ 1 with x2 ≥ 0: no point with x0 = x1 = 1 meets both; the QP's optimum
-    // is x0 = x1 = 0.5, x2 = 0 (residual 0.25 + 0.25).
-    L[0].D << unitRow(0) + unitRow(1) + unitRow(2), unitRow(2);
-    L[0].lower << -hqp::kInf, 0.0;
-    L[0].upper << 1.0, hqp::kInf;
+    // x4 + x5 + x2 ≤ 1 with x2 ≥ 0: no point with x4 = x5 = 1 meets both; the QP's optimum
+    // is x4 = x5 = 0.5, x2 = 0 (residual 0.25 + 0.25).
+    L[1].D << unitRow(4) + unitRow(5) + unitRow(2), unitRow(2);
+    L[1].lower << -hqp::kInf, 0.0;
+    L[1].upper << 1.0, hqp::kInf;
   }
-  L[1].D << unitRow(4), unitRow(5);
   L[2].D << unitRow(6);
   return L;
 }
@@ -511,21 +515,22 @@ TEST(HqpInequality, LeastDistanceStepGivesTheLevelsMinimumNormOptimum) {
   }
   without.setLeastDistanceStep(false);
   Eigen::Matrix<double, N, 1> expect;
-  expect << 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0;
+  expect << 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 0.0;
   const auto L = leastDistanceLevels(true);
   fill(with, L);
   fill(without, L);
   ASSERT_EQ(with.solve(), hqp::QpStatus::Optimal);
   ASSERT_EQ(without.solve(), hqp::QpStatus::Optimal);
-  const auto& a = with.result().levels[0];
+  EXPECT_FALSE(with.result().levels[0].least_distance);  // its free step meets every row
+  const auto& a = with.result().levels[1];
   EXPECT_TRUE(a.least_distance);
   EXPECT_EQ(a.iterations, 1);
   EXPECT_EQ(a.num_active, 0);  // the row holds with multiplier 0: the level sits at its minimum
   EXPECT_LT(a.residual, 1e-28);
   EXPECT_LE((with.result().x - expect).cwiseAbs().maxCoeff(), 1e-14);
   // The QP reaches the same point by its own route.
-  EXPECT_FALSE(without.result().levels[0].least_distance);
-  EXPECT_GT(without.result().levels[0].iterations, 0);
+  EXPECT_FALSE(without.result().levels[1].least_distance);
+  EXPECT_GT(without.result().levels[1].iterations, 0);
   EXPECT_LE((without.result().x - expect).cwiseAbs().maxCoeff(), 1e-14);
 }
 
@@ -535,11 +540,12 @@ TEST(HqpInequality, LeastDistanceStepLeavesAnInconsistentLevelToItsQp) {
   wbc.setWarmStart(false);
   fill(wbc, leastDistanceLevels(false));
   ASSERT_EQ(wbc.solve(), hqp::QpStatus::Optimal);
-  const auto& l = wbc.result().levels[0];
+  const auto& l = wbc.result().levels[1];
   EXPECT_FALSE(l.least_distance);
+  EXPECT_GT(l.iterations, 0);  // the step's failed try, then the QP's
   EXPECT_NEAR(l.residual, 0.5, 1e-14);
   Eigen::Matrix<double, N, 1> expect;
-  expect << 0.5, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0;
+  expect << 1.0, 1.0, 0.0, 0.0, 0.5, 0.5, 0.0;
   EXPECT_LE((wbc.result().x - expect).cwiseAbs().maxCoeff(), 1e-14);
 }
 
@@ -555,9 +561,16 @@ TEST(HqpInequality, LeastDistanceStepAgreesWithTheLevelQps) {
   without.setLeastDistanceStep(false);
   int steps = 0;
   for (int trial = 0; trial < 200; ++trial) {
-    const auto L = makeLevels(trial % 3, g);
+    Eigen::VectorXd inside;
+    auto L = makeLevels(trial % 3, g, &inside);
+    // Every other trial, levels 1 and 2 can reach their targets (at a point inside every row):
+    // then their free steps often break a row while an unconstrained minimizer meets them all.
+    if (trial % 2 == 1)
+      for (int p = 0; p < 2; ++p) L[static_cast<size_t>(p)].b = L[static_cast<size_t>(p)].A * inside;
     fill(with, L);
     fill(without, L);
+    with.resetWarmStart();  // the steps are tried on empty working sets only
+    without.resetWarmStart();
     ASSERT_EQ(with.solve(), without.solve()) << "trial " << trial;
     const auto ref = hqp::testing::bruteForceCascade(L, N);
     for (int p = 0; p < 4; ++p) {
@@ -572,6 +585,7 @@ TEST(HqpInequality, LeastDistanceStepAgreesWithTheLevelQps) {
     EXPECT_LE((with.result().x - without.result().x).cwiseAbs().maxCoeff(),
               1e-8 * (1.0 + without.result().x.cwiseAbs().maxCoeff())) << "trial " << trial;
   }
+  std::printf("least-distance steps taken: %d of 800 levels\n", steps);
   EXPECT_GE(steps, 50);  // the step was taken, not only tried
 }
 
