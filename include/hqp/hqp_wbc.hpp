@@ -919,19 +919,11 @@ class HqpWbc {
     cnorm_.head(c) = Cw.rowwise().squaredNorm();
     const int own_begin = ownBegin(c0);
     for (int i = 0; i < c; ++i) {
-      double lo = lower_(i) - dx_(i), up = upper_(i) - dx_(i);
       // An own row with an empty interval: infeasible, the general path applies the policy.
       if (i >= own_begin &&
           (lower_(i) - upper_(i)) / rowScale(Dnorm_(i)) > settings_.qp.feasibility_tol)
         return false;
-      widenHigherRow(i, own_begin, lo, up);
-      if (lockedRow(i, cnorm_(i))) {
-        if (i >= own_begin && !lockedRowHolds(i, lo, up)) return false;
-        lo = -kInf;
-        up = kInf;
-      }
-      dlo_(i) = lo;
-      dup_(i) = up;
+      if (!dualRowBounds(i, own_begin, 0.0, cnorm_(i), i >= own_begin)) return false;
     }
     // Any order of the violated rows is valid for the dual method, and an order that ends on
     // nearly dependent rows (NumericalFailure) may be avoided by another, so up to three run
@@ -1183,19 +1175,8 @@ class HqpWbc {
       if (!settings_.least_distance_step || deferred_ || m <= 0 || m > dual_variables) return false;
       const auto Cw = W_.block(total_task_rows, col0, c, n);
       const auto Cv = Cw.middleCols(k, m);
-      for (int i = 0; i < c; ++i) {
-        double lo = lower_(i) - dx_(i), up = upper_(i) - dx_(i);
-        widenHigherRow(i, ownBegin(c0), lo, up);
-        lo -= tmp_(i);
-        up -= tmp_(i);
-        if (lockedRow(i, Cv.row(i).squaredNorm())) {
-          if (!lockedRowHolds(i, lo, up)) return false;
-          lo = -kInf;
-          up = kInf;
-        }
-        dlo_(i) = lo;
-        dup_(i) = up;
-      }
+      for (int i = 0; i < c; ++i)
+        if (!dualRowBounds(i, ownBegin(c0), tmp_(i), Cv.row(i).squaredNorm(), true)) return false;
       if (!dual_.factorizeIdentity(m)) return false;
       const QpStatus s = dual_.solve(Cv, dlo_, dup_, c, settings_.qp);
       lr.iterations = dual_.iterations();
@@ -1258,6 +1239,24 @@ class HqpWbc {
     if (i >= own_begin) return;
     lo = std::min(lo, 0.0);
     up = std::max(up, 0.0);
+  }
+  // Row i's bounds for a dual solve (dlo_, dup_): the QP's (shifted by D x*_{p−1}, higher rows
+  // widened to contain 0), minus shift (the row's value at the dual method's origin); a
+  // locked row (reduced squared norm rn2) is freed, and if must_hold it has to hold there:
+  // false if it does not.
+  bool dualRowBounds(int i, int own_begin, double shift, double rn2, bool must_hold) {
+    double lo = lower_(i) - dx_(i), up = upper_(i) - dx_(i);
+    widenHigherRow(i, own_begin, lo, up);
+    lo -= shift;
+    up -= shift;
+    if (lockedRow(i, rn2)) {
+      if (must_hold && !lockedRowHolds(i, lo, up)) return false;
+      lo = -kInf;
+      up = kInf;
+    }
+    dlo_(i) = lo;
+    dup_(i) = up;
+    return true;
   }
   // Row i is locked by the higher levels if its reduced row (squared norm rn2) is ≤ rank_tol ‖D_i‖.
   bool lockedRow(int i, double rn2) const { return std::sqrt(rn2) <= settings_.rank_tol * Dnorm_(i); }
