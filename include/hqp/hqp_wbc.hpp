@@ -224,8 +224,8 @@ class HqpWbc {
   // The last level's dual solver (HqpSettings::dual_last_level): it sees at most as many
   // variables as the level has task rows. The least-distance step (HqpSettings::
   // least_distance_step) uses it too, on levels whose null space fits in that size: sized for
-  // Nx instead, its small products leave Eigen's fixed-size paths and the last level's solve
-  // slows by a few per cent, and a second solver type would cost compile time in every unit.
+  // Nx instead, the last level's solve measured a few per cent slower (docs/benchmarks.md), and
+  // a second solver type would cost compile time in every unit.
   static constexpr int last_task_rows = LevelType<sizeof...(Levels) - 1>::task_rows;
   static constexpr int dual_variables = std::min(Nx, last_task_rows);
   using DualQp = std::conditional_t<
@@ -1162,8 +1162,8 @@ class HqpWbc {
   // last level's dual solver, n − k ≤ dual_variables). A row with no part in
   // v (locked: the higher levels fix it) must already hold. Above the last level only (its
   // rows below are rotated); not on the deferred path (its levels check no row). On success
-  // u_ = [y; v], lr.iterations = the dual method's; false (nothing else changed) if no such
-  // point exists or the method does not end Optimal: the level's QP decides.
+  // u_ = [y; v], lr.iterations = the dual method's; false (u_ untouched, lr.iterations the
+  // try's) if no such point exists or the method does not end Optimal: the level's QP decides.
   template <int P>
   bool leastDistanceStep(int n, int k, int col0, HqpLevelResult<max_active>& lr) {
     if constexpr (P + 1 == num_levels || std::is_same_v<DualQp, detail::NoQp>) {
