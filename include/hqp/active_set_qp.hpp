@@ -30,6 +30,7 @@
 #include <limits>
 
 #include "hqp/detail/householder_strips.hpp"
+#include "hqp/detail/nonnegative_least_squares.hpp"
 #include "hqp/detail/qp_min_norm_ls.hpp"
 #include "hqp/qp_settings.hpp"
 #include "hqp/qp_status.hpp"
@@ -197,6 +198,10 @@ class ActiveSetQp {
   bool phase1Certified();              // phase 1's multipliers prove infeasibility (Farkas)
   bool equalitiesCertified();          // a dependent equality contradicts the others
   bool multipliers();                  // lam_ for K at x = xs_ (needs y_ from subproblem())
+  // The optimality test on a nearly dependent K, where lam_'s signs are noise (docs/active-set-
+  // qp.md, "Multipliers on a nearly dependent working set"): multipliers of the working set by
+  // non-negative least squares on its rows. True if they prove xs_ optimal (lam_ set to them).
+  bool coneMultipliers(double gs);
   QpStatus iterate(bool phase1);       // the active-set loop on the current phase
   double maxViolation(const VecN& v);  // scaled, over E and C (uses ev_, cx_)
   // Every row of E and C holds at v: scaled violation ≤ feasibility_tol · (1 + |ĉ v|)
@@ -306,6 +311,10 @@ class ActiveSetQp {
   Eigen::Matrix<double, MI, 1> cd_, cx_;  // Ĉ d, Ĉ x (ratio test)
   bool cx_at_xc_ = false;                 // cx_ = Ĉ xc_ exactly (set by maxViolation(xc_))
   detail::QpMinNormWorkspace<MR, NV> cod_;
+  // coneMultipliers(): the working set's rows (x part; both signs for equalities) as columns.
+  detail::NonNegativeLeastSquares<MaxN, 2 * NV> cone_;
+  Eigen::Matrix<int, 2 * NV, 1> cone_row_;      // K row of column l
+  Eigen::Matrix<double, 2 * NV, 1> cone_sign_;  // its sign
 
   VectorX x_;
   VectorEq lam_eq_;
@@ -1103,7 +1112,28 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::iterate(bool phase1) {
         drop = w;
       }
     }
-    if (drop < 0) return QpStatus::Optimal;
+    if (drop < 0) {
+      // The signs are only as good as R: λ = R⁻¹ y carries an error of about ε κ ‖λ‖ (κ ≥ the
+      // ratio of R's extreme diagonal entries). If that exceeds the test's tolerance and a
+      // multiplier taken as ≥ 0 lies within it, the sign test proves nothing: check the cone.
+      if (phase1 || neq_ == k_) return QpStatus::Optimal;
+      double lmax = 0.0, rmax = 0.0, rmin = std::numeric_limits<double>::infinity(),
+             mmin = std::numeric_limits<double>::infinity();
+      for (int i = 0; i < k_; ++i) {
+        lmax = std::max(lmax, std::abs(lam_(i)));
+        rmax = std::max(rmax, std::abs(R_(i, i)));
+        rmin = std::min(rmin, std::abs(R_(i, i)));
+      }
+      for (int w = 0; w < nw_; ++w) {
+        const int j = ws_row_(w);
+        if (ls_(j) != us_(j) && !pin_(j))
+          mmin = std::min(mmin, ws_upper_(w) ? lam_(neq_ + w) : -lam_(neq_ + w));
+      }
+      const double noise = std::numeric_limits<double>::epsilon() * (rmax / rmin) * lmax;
+      // Noise within the sign test's own tolerance, or every sign above it: the test holds.
+      if (!(noise > -thr) || !(mmin <= noise)) return QpStatus::Optimal;
+      return coneMultipliers(gs) ? QpStatus::Optimal : QpStatus::NumericalFailure;
+    }
     if (iterations_ >= settings_.max_iterations) return QpStatus::IterationLimit;
     ++iterations_;
     ensureExplicit();
@@ -1146,6 +1176,57 @@ bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::phase1Certified() {
   const double rho = d_.head(n_).norm();
   const double X = tol / std::numeric_limits<double>::epsilon() * (1.0 + bmax);
   return rho <= 1e-12 * ysum && gap > slack + rho * X;
+}
+
+template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
+bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::coneMultipliers(double gs) {
+  // Stationarity g + Σ μ_l s_l k_l = 0 over K's rows k_l (unit norm) with signs s_l (+ at an
+  // upper bound, − at a lower one, both for equalities and rows with lower == upper), μ ≥ 0:
+  // min ‖E μ + g‖ s.t. μ ≥ 0 (Lawson and Hanson's NNLS, detail/nonnegative_least_squares.hpp).
+  // Its residual ρ = −(g + E μ*) is unique however dependent the rows are, and a feasible
+  // descent direction (the passive columns are orthogonal to ρ, every other column has
+  // (s_l k_l)·ρ ≤ 0, and gᵀρ = −‖ρ‖²): ‖ρ‖ at rounding proves x optimal, a larger one that it
+  // is not, whatever the sign test on the ill-conditioned multipliers said.
+  const int n = n_;
+  auto& E = cone_.E();
+  auto& f = cone_.f();
+  if (m_ > 0) {
+    r_.head(m_).noalias() = A_ * xs_.head(n);
+    r_.head(m_) -= b_;
+    f.head(n).noalias() = -A_.transpose() * r_.head(m_);
+  } else {
+    f.head(n).setZero();
+  }
+  int cols = 0;
+  const auto column = [&](int i, double sign) {
+    const bool eq = i < neq_;
+    const int j = eq ? eq_pos_(i) : ws_row_(i - neq_);
+    for (int c = 0; c < n; ++c) E(c, cols) = sign * (eq ? Es_(j, c) : Cs_(j, c));
+    cone_row_(cols) = i;
+    cone_sign_(cols) = sign;
+    ++cols;
+  };
+  for (int i = 0; i < k_; ++i) {
+    const bool two_sided = i < neq_ || ls_(ws_row_(i - neq_)) == us_(ws_row_(i - neq_));
+    if (two_sided) {
+      column(i, 1.0);
+      column(i, -1.0);
+    } else {
+      column(i, ws_upper_(i - neq_) ? 1.0 : -1.0);
+    }
+  }
+  const int cap = std::max(settings_.max_iterations, 3 * cols);
+  if (!cone_.solve(n, cols, cap)) return false;
+  // Tolerance: the sign test's, plus the rounding of E μ (unit columns).
+  const double gn = f.head(n).norm();
+  const double tol = settings_.dual_tol * std::max(gs, gn) +
+                     64.0 * std::numeric_limits<double>::epsilon() * cone_.mu().head(cols).sum();
+  if (cone_.residual().head(n).norm() <= tol) {
+    lam_.head(k_).setZero();
+    for (int l = 0; l < cols; ++l) lam_(cone_row_(l)) += cone_sign_(l) * cone_.mu()(l);
+    return true;
+  }
+  return false;
 }
 
 template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>

@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <random>
+#include <string>
 
 #include "hqp/active_set_qp.hpp"
 #include "support/brute_force_qp.hpp"
@@ -99,6 +101,78 @@ TEST(QpHard, LongStepIsBlockedByANearlyOrthogonalRow) {
   EXPECT_LE(qp.objective(), 1e-20);
   ASSERT_EQ(qp.numActive(), 1);
   EXPECT_TRUE(qp.activeAtUpper(0));
+}
+
+TEST(QpHard, WedgeOfNearlyOppositeRowsKeepsItsLargeMultipliers) {
+  // min ½‖x − (0, 10)‖² s.t. x1 ≤ 0, −x1 + δ x2 ≤ 0 (δ = 1e-9): the rows meet at an angle of
+  // δ, the objective pushes into the wedge, and the optimum is the apex x = 0 (objective 50)
+  // with multipliers μ = 10/δ = 1e10 on both rows (closed form of g + Σ μ c = 0). The working
+  // set is nearly dependent, yet the multipliers are far above their rounding (ε κ ‖λ‖ ≈ 2e3):
+  // the solver must keep calling this vertex optimal.
+  Qp qp;
+  qp.resize(2, 2, 0, 2);
+  qp.A() << 1.0, 0.0, 0.0, 1.0;
+  qp.b() << 0.0, 10.0;
+  qp.C() << 1.0, 0.0, -1.0, 1e-9;
+  qp.lower() << -kInf, -kInf;
+  qp.upper() << 0.0, 0.0;
+  ASSERT_EQ(str(qp.solve(false)), "Optimal");
+  EXPECT_LE(violation(qp), 1e-9);
+  EXPECT_NEAR(qp.objective(), 50.0, 1e-6);
+  ASSERT_EQ(qp.numActive(), 2);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_TRUE(qp.activeAtUpper(k));
+    EXPECT_NEAR(qp.multiplier(k), 1e10, 1e4) << "row " << qp.activeRow(k);
+  }
+}
+
+// A last level of HqpWbc recorded from the stress corpus: its primal path ends on a vertex whose
+// working set is numerically dependent (σ_min 2e-16 of the unit rows), where the multipliers'
+// signs are rounding noise. Before the cone check the solver called it Optimal at 1247.55, 52 %
+// above the optimum 823.0864727 (scipy trust-constr, tests/data/qp_nearly_dependent_vertex.txt).
+// Now it must not claim Optimal above the optimum; a NumericalFailure keeps x feasible.
+TEST(QpHard, NumericallyDependentVertexIsNotCalledOptimalAboveTheOptimum) {
+  std::ifstream in(HQP_NEARLY_DEPENDENT_QP_FILE);
+  ASSERT_TRUE(in.good()) << HQP_NEARLY_DEPENDENT_QP_FILE;
+  std::string line;
+  while (in.peek() == '#') std::getline(in, line);
+  int n = 0, m = 0, me = 0, mi = 0;
+  in >> n >> m >> me >> mi;
+  ASSERT_EQ(n, 9);
+  ASSERT_EQ(m, 15);
+  ASSERT_EQ(me, 0);
+  ASSERT_EQ(mi, 30);
+  hqp::ActiveSetQp<9, 15, 0, 30> qp;
+  qp.resize(n, m, me, mi);
+  const auto number = [&in] {
+    std::string t;
+    in >> t;
+    return std::stod(t);  // also "inf", "-inf"
+  };
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < n; ++j) qp.A()(i, j) = number();
+  for (int i = 0; i < m; ++i) qp.b()(i) = number();
+  for (int i = 0; i < mi; ++i)
+    for (int j = 0; j < n; ++j) qp.C()(i, j) = number();
+  for (int i = 0; i < mi; ++i) qp.lower()(i) = number();
+  for (int i = 0; i < mi; ++i) qp.upper()(i) = number();
+  ASSERT_TRUE(in.good());
+  constexpr double kOptimum = 823.0864727;
+  for (int hint = 0; hint < 2; ++hint) {
+    qp.resetWorkingSet();
+    const hqp::QpStatus s = hint ? qp.solve(Eigen::VectorXd::Zero(n).eval(), false) : qp.solve(false);
+    ASSERT_TRUE(qp.x().allFinite());
+    double viol = 0.0;
+    for (int j = 0; j < mi; ++j) {
+      const double cx = qp.C().row(j).dot(qp.x()), nr = qp.C().row(j).norm();
+      viol = std::max(viol, std::max(qp.lower()(j) - cx, cx - qp.upper()(j)) / nr);
+    }
+    EXPECT_LE(viol, 1e-8);
+    if (s == hqp::QpStatus::Optimal)
+      EXPECT_LE(qp.objective(), kOptimum * (1.0 + 1e-6)) << "Optimal above the optimum";
+    else
+      EXPECT_EQ(str(s), "NumericalFailure");
+  }
 }
 
 TEST(QpHard, RedundantConsistentEqualities) {
