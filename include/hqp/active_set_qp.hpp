@@ -1207,15 +1207,15 @@ bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::coneMultipliers(double gs) {
     ++cols;
   };
   for (int i = 0; i < k_; ++i) {
-    const bool two_sided = i < neq_ || ls_(ws_row_(i - neq_)) == us_(ws_row_(i - neq_));
-    if (two_sided) {
+    const int w = i - neq_;
+    if (w < 0 || ls_(ws_row_(w)) == us_(ws_row_(w))) {  // equality: both signs
       column(i, 1.0);
       column(i, -1.0);
     } else {
-      column(i, ws_upper_(i - neq_) ? 1.0 : -1.0);
+      column(i, ws_upper_(w) ? 1.0 : -1.0);
     }
   }
-  const int cap = std::max(settings_.max_iterations, 3 * cols);
+  const int cap = decltype(cone_)::iterationCap(settings_.max_iterations, cols);
   if (!cone_.solve(n, cols, cap)) return false;
   // Tolerance: the sign test's, plus the rounding of E μ (unit columns).
   const double gn = f.head(n).norm();

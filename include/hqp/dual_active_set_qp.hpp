@@ -363,10 +363,7 @@ class DualActiveSetQp {
     }
     ldp_.f().head(n + 1).setZero();
     ldp_.f()(n) = 1.0;
-    // Each active row costs the NNLS at least one step (61.9 on average, above 100 on 2 of 200
-    // random QPs with 30 variables and 60 rows): its cap is 3 steps per column, Lawson and
-    // Hanson's, or max_iterations if larger.
-    const int cap = std::max(settings.max_iterations, 3 * cols);
+    const int cap = decltype(ldp_)::iterationCap(settings.max_iterations, cols);
     const bool done = ldp_.solve(n + 1, cols, cap, dependent);
     iterations_ = ldp_.iterations();
     if (!done) return iterations_ >= cap ? QpStatus::IterationLimit : QpStatus::NumericalFailure;
