@@ -82,6 +82,12 @@ struct HqpSettings {
   // for the dual method. If one exists it is the level's minimum-norm optimum (the level's
   // objective is at its unconstrained minimum there); if none does, the level's QP runs.
   bool least_distance_step = true;
+  // Dual start (docs/hqp.md, "Dual start"): a level between the first and the last whose QP has
+  // no working set and whose start u = 0 breaks a row (phase 1 would run, and the primal method
+  // would then climb back from a far vertex) first solves the level with ½δ‖v‖² added on its
+  // null-space part v (strictly convex, so the dual method applies) and hands that solution's
+  // active rows to the QP as its working set. The QP then solves the level: the answer is the QP's.
+  bool dual_start = true;
 };
 
 // KKT residuals of one level's QP (docs/hqp.md, "Certificate"), in its variables u (x = x*_{p−1}
@@ -123,6 +129,9 @@ struct HqpLevelResult {
   // At the minimum-norm unconstrained minimizer that meets every row, found by the dual method
   // without the level's QP (HqpSettings::least_distance_step); iterations are that method's.
   bool least_distance = false;
+  // The level's QP started from the dual start's working set (HqpSettings::dual_start);
+  // iterations include the dual method's.
+  bool dual_start = false;
   // The level's residual at the final x rose beyond HqpSettings::residual_rise_tol above its
   // value at x*_p: the lower levels degraded it (numerical health, docs/hqp.md).
   bool degraded = false;
@@ -232,6 +241,12 @@ class HqpWbc {
       (total_constraint_rows > 0 && last_task_rows > 0),
       DualActiveSetQp<dual_variables, last_task_rows, capacity(total_constraint_rows)>,
       detail::NoQp>;
+  // The dual start's solver (HqpSettings::dual_start): a level's variables (up to Nx), the
+  // level's task rows plus one row per null-space variable. Levels between the first and last.
+  using StartQp = std::conditional_t<
+      (total_constraint_rows > 0 && sizeof...(Levels) > 2),
+      DualActiveSetQp<Nx, Nx + capacity(max_task_rows), capacity(total_constraint_rows)>,
+      detail::NoQp>;
   using SlackQp = std::conditional_t<
       has_slack_levels,
       ActiveSetQp<Nx + capacity(max_slack_rows), capacity(max_slack_rows), 0,
@@ -266,6 +281,7 @@ class HqpWbc {
   void setKktResiduals(bool on) { settings_.kkt_residuals = on; }  // HqpSettings::kkt_residuals
   void setDeferConstraints(bool on) { settings_.defer_constraints = on; }
   void setLeastDistanceStep(bool on) { settings_.least_distance_step = on; }
+  void setDualStart(bool on) { settings_.dual_start = on; }
   // Per-solve budget (HqpSettings::budget_us / budget_iterations; ≤ 0 = none).
   void setBudget(double us, int iterations) {
     settings_.budget_us = us;
@@ -759,9 +775,15 @@ class HqpWbc {
       hint.setZero(n);  // x*_{p−1} meets every higher constraint: u = 0 is feasible for them
       const bool locked_infeasible = neutralizeLockedRows(qp, c, ownBegin(c0));
       QpStatus s = QpStatus::Infeasible;
+      bool warm = settings_.warm_start;
+      if constexpr (P > 0 && !last && !std::is_same_v<StartQp, detail::NoQp>) {
+        if (!locked_infeasible && !deferred_ && settings_.dual_start && qp.numActive() == 0 &&
+            dualStart<P>(qp, n, k, c, lr))
+          warm = true;  // the working set just set
+      }
       if (!locked_infeasible) {
-        s = qp.solve(hint, settings_.warm_start);  // the hint is used only if feasible
-        lr.iterations += qp.iterations();  // after a failed least-distance step's
+        s = qp.solve(hint, warm);  // the hint is used only if feasible
+        lr.iterations += qp.iterations();  // after a failed least-distance step's, the dual start's
       }
       if (deferred_ && s != QpStatus::Optimal) {  // some level above is not at its minimum
         aborted_ = true;
@@ -1189,6 +1211,44 @@ class HqpWbc {
     }
   }
 
+  // The dual start (HqpSettings::dual_start) for level P's QP (its data set, hint u = 0): if
+  // u = 0 breaks a row, min ½‖Â Q₁ y − b̂‖² + ½δ‖v‖² over u' = [y; v] s.t. the QP's rows, by the
+  // dual method from its unconstrained minimizer; its active rows become the QP's working set.
+  // √δ = 1e-4 ‖Â‖_F: cond of the stacked objective ~1e4 (the dual method's errors grow with its
+  // square), and small enough that its active set is the level's on the measured instances.
+  // True if the working set was set (lr.iterations and lr.dual_start record the try).
+  template <int P, class Qp>
+  bool dualStart(Qp& qp, int n, int k, int c, HqpLevelResult<max_active>& lr) {
+    constexpr int r = LevelType<P>::task_rows;
+    const double tol = settings_.qp.feasibility_tol;
+    bool breaks = false;  // the QP's own test, on rows scaled to unit norm (cnorm_: their ‖·‖²)
+    for (int i = 0; i < c && !breaks; ++i) {
+      const double sc = std::sqrt(cnorm_(i));
+      breaks = qp.lower()(i) > tol * sc || qp.upper()(i) < -tol * sc;
+    }
+    if (!breaks) return false;
+    const int m = n - k;
+    Fs_.setZero(r + m, n);
+    Fs_.topRows(r) = qp.A();  // Â Q with columns k.. zero (truncated to rank k)
+    const double an = qp.A().norm();
+    const double sd = 1e-4 * (an > 0.0 ? an : 1.0);
+    for (int i = 0; i < m; ++i) Fs_(r + i, k + i) = sd;
+    fs_.setZero(r + m);
+    fs_.head(r) = qp.b();
+    if (!start_.factorize(Fs_, fs_, r + m, n, 0.0)) return false;
+    const QpStatus s = start_.solve(qp.C(), qp.lower(), qp.upper(), c, settings_.qp);
+    lr.iterations += start_.iterations();
+    if (s != QpStatus::Optimal || start_.numActive() == 0) return false;
+    const int cnt = std::min(start_.numActive(), max_active);
+    for (int a = 0; a < cnt; ++a) {
+      start_row_[static_cast<std::size_t>(a)] = start_.activeRow(a);
+      start_upper_[static_cast<std::size_t>(a)] = start_.activeAtUpper(a);
+    }
+    qp.setWorkingSet(cnt, start_row_.data(), start_upper_.data());
+    lr.dual_start = true;
+    return true;
+  }
+
   // ys_(0:k) = argmin ‖L y − b'‖, L = Â_p Q₁ of full column rank k (NullSpace): the row-space
   // part of the level's unconstrained minimum-norm step. False if the solve failed.
   template <int P>
@@ -1365,6 +1425,11 @@ class HqpWbc {
   QpTuple qps_;
   SlackQp slack_qp_;
   DualQp dual_;
+  StartQp start_;  // the dual start: its solver, objective [Â Q; 0 √δ I] and b̂, working set
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, Nx + capacity(max_task_rows), Nx> Fs_;
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, Nx + capacity(max_task_rows), 1> fs_;
+  std::array<int, max_active> start_row_{};
+  std::array<bool, max_active> start_upper_{};
   VectorC dlo_ = VectorC::Zero(), dup_ = VectorC::Zero();  // its bounds
   std::array<int, Nx> prefer_{};                            // its warm start
   LeastSquares ls_;

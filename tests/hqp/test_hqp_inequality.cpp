@@ -589,6 +589,88 @@ TEST(HqpInequality, LeastDistanceStepAgreesWithTheLevelQps) {
   EXPECT_GE(steps, 50);  // the step was taken, not only tried
 }
 
+// Dual start: level 2's start x*_1 = 0 breaks its row x0 ≥ 1 and its target (3, 3) is out of
+// reach of x0 + x1 ≤ 2, so its QP would run phase 1 (its null space of 5 does not fit the
+// least-distance step's solver). Closed form: x0 = x1 = 1 (the projection of (3, 3) onto
+// x0 + x1 = 2, which meets x0 ≥ 1), residual 2² + 2², multiplier 2.
+TEST(HqpInequality, DualStartHandsTheQpTheLevelsActiveRows) {
+  static Wbc with, without;
+  for (Wbc* w : {&with, &without}) {
+    w->setDeferConstraints(false);
+    w->setWarmStart(false);
+  }
+  without.setDualStart(false);
+  auto L = leastDistanceLevels(true);
+  for (auto& l : L) {  // only level 2 has rows: x = (1, 1, 0, …) by minimum norm
+    l.A.setZero();
+    l.b.setZero();
+    l.D.setZero();
+    l.lower.setConstant(-100.0);
+    l.upper.setConstant(100.0);
+  }
+  L[1].A << unitRow(0), unitRow(1);
+  L[1].b << 3.0, 3.0;
+  L[1].D << unitRow(0) + unitRow(1), unitRow(0);
+  L[1].lower << -hqp::kInf, 1.0;
+  L[1].upper << 2.0, hqp::kInf;
+  fill(with, L);
+  fill(without, L);
+  ASSERT_EQ(with.solve(), hqp::QpStatus::Optimal);
+  ASSERT_EQ(without.solve(), hqp::QpStatus::Optimal);
+  Eigen::Matrix<double, N, 1> expect = Eigen::Matrix<double, N, 1>::Zero();
+  expect(0) = expect(1) = 1.0;
+  const auto& a = with.result().levels[1];
+  EXPECT_TRUE(a.dual_start);
+  EXPECT_FALSE(without.result().levels[1].dual_start);
+  EXPECT_NEAR(a.residual, 8.0, 1e-12);
+  ASSERT_EQ(a.num_active, 1);  // x0 + x1 ≤ 2 (stacked row 2) at its upper bound
+  EXPECT_EQ(a.active_row[0], 2);
+  EXPECT_TRUE(a.active_upper[0]);
+  EXPECT_NEAR(a.multiplier[0], 2.0, 1e-12);
+  EXPECT_LE((with.result().x - expect).cwiseAbs().maxCoeff(), 1e-14);
+  EXPECT_LE((without.result().x - expect).cwiseAbs().maxCoeff(), 1e-14);
+  // The dual method's one step replaces phase 1 and the primal steps.
+  EXPECT_LT(a.iterations, without.result().levels[1].iterations);
+}
+
+// On random hierarchies (cascade, empty working sets, every kind including a dropped level)
+// the dual start changes the route, not the answer: statuses, per-level residuals and x agree
+// with the run without it, and the residuals with the brute-force reference.
+TEST(HqpInequality, DualStartAgreesWithTheLevelQps) {
+  std::mt19937 g(47);
+  static Wbc with, without;
+  for (Wbc* w : {&with, &without}) {
+    w->setDeferConstraints(false);
+    w->setWarmStart(false);
+  }
+  without.setDualStart(false);
+  int starts = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    auto L = makeLevels(trial % 4, g);
+    fill(with, L);
+    fill(without, L);
+    with.resetWarmStart();  // the start is tried on empty working sets only
+    without.resetWarmStart();
+    ASSERT_EQ(with.solve(), without.solve()) << "trial " << trial;
+    const auto ref = hqp::testing::bruteForceCascade(L, N);
+    for (int p = 0; p < 4; ++p) {
+      const size_t q = static_cast<size_t>(p);
+      starts += with.result().levels[q].dual_start;
+      EXPECT_FALSE(without.result().levels[q].dual_start);
+      EXPECT_EQ(with.result().levels[q].status, without.result().levels[q].status) << "trial " << trial;
+      EXPECT_NEAR(with.result().levels[q].residual, without.result().levels[q].residual,
+                  1e-9 * (1.0 + without.result().levels[q].residual)) << "trial " << trial;
+      if (trial % 4 != 3)  // the reference keeps a dropped level's rows
+        EXPECT_NEAR(with.result().levels[q].residual, ref.residual[q], 1e-8 * (1.0 + ref.residual[q]))
+            << "trial " << trial << " level " << p;
+    }
+    EXPECT_LE((with.result().x - without.result().x).cwiseAbs().maxCoeff(),
+              1e-8 * (1.0 + without.result().x.cwiseAbs().maxCoeff())) << "trial " << trial;
+  }
+  std::printf("dual starts taken: %d of 600 levels (levels 2 and 3)\n", starts);
+  EXPECT_GE(starts, 100);  // the start was taken, not only tried
+}
+
 TEST(HqpInequality, NanInputNeverGivesNan) {
   std::mt19937 g(8);
   static Wbc wbc;
