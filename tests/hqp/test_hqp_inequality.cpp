@@ -549,6 +549,30 @@ TEST(HqpInequality, LeastDistanceStepLeavesAnInconsistentLevelToItsQp) {
   EXPECT_LE((wbc.result().x - expect).cwiseAbs().maxCoeff(), 1e-14);
 }
 
+// Solves L with `with` (a route switched on) and `without` (switched off) from empty working
+// sets and checks that the route changes nothing: status per level, per-level residuals and x
+// to rounding, and (check_ref) the residuals against the brute-force cascade.
+void expectSameAnswer(Wbc& with, Wbc& without, const std::vector<hqp::testing::RefLevel>& L,
+                      int trial, bool check_ref) {
+  fill(with, L);
+  fill(without, L);
+  with.resetWarmStart();  // the routes are tried on empty working sets only
+  without.resetWarmStart();
+  ASSERT_EQ(with.solve(), without.solve()) << "trial " << trial;
+  const auto ref = hqp::testing::bruteForceCascade(L, N);
+  for (int p = 0; p < 4; ++p) {
+    const size_t q = static_cast<size_t>(p);
+    const auto &a = with.result().levels[q], &b = without.result().levels[q];
+    EXPECT_EQ(a.status, b.status) << "trial " << trial << " level " << p;
+    EXPECT_NEAR(a.residual, b.residual, 1e-9 * (1.0 + b.residual)) << "trial " << trial;
+    if (check_ref)
+      EXPECT_NEAR(a.residual, ref.residual[q], 1e-8 * (1.0 + ref.residual[q]))
+          << "trial " << trial << " level " << p;
+  }
+  EXPECT_LE((with.result().x - without.result().x).cwiseAbs().maxCoeff(),
+            1e-8 * (1.0 + without.result().x.cwiseAbs().maxCoeff())) << "trial " << trial;
+}
+
 // On random hierarchies (cascade, cold) the step changes the route, not the answer: the
 // per-level residuals and x agree with the QPs' to rounding, and the brute-force reference.
 TEST(HqpInequality, LeastDistanceStepAgreesWithTheLevelQps) {
@@ -567,23 +591,11 @@ TEST(HqpInequality, LeastDistanceStepAgreesWithTheLevelQps) {
     // then their free steps often break a row while an unconstrained minimizer meets them all.
     if (trial % 2 == 1)
       for (int p = 0; p < 2; ++p) L[static_cast<size_t>(p)].b = L[static_cast<size_t>(p)].A * inside;
-    fill(with, L);
-    fill(without, L);
-    with.resetWarmStart();  // the steps are tried on empty working sets only
-    without.resetWarmStart();
-    ASSERT_EQ(with.solve(), without.solve()) << "trial " << trial;
-    const auto ref = hqp::testing::bruteForceCascade(L, N);
+    expectSameAnswer(with, without, L, trial, true);
     for (int p = 0; p < 4; ++p) {
-      const size_t q = static_cast<size_t>(p);
-      steps += with.result().levels[q].least_distance;
-      EXPECT_FALSE(without.result().levels[q].least_distance);
-      EXPECT_NEAR(with.result().levels[q].residual, without.result().levels[q].residual,
-                  1e-9 * (1.0 + without.result().levels[q].residual)) << "trial " << trial;
-      EXPECT_NEAR(with.result().levels[q].residual, ref.residual[q], 1e-8 * (1.0 + ref.residual[q]))
-          << "trial " << trial << " level " << p;
+      steps += with.result().levels[static_cast<size_t>(p)].least_distance;
+      EXPECT_FALSE(without.result().levels[static_cast<size_t>(p)].least_distance);
     }
-    EXPECT_LE((with.result().x - without.result().x).cwiseAbs().maxCoeff(),
-              1e-8 * (1.0 + without.result().x.cwiseAbs().maxCoeff())) << "trial " << trial;
   }
   std::printf("least-distance steps taken: %d of 800 levels\n", steps);
   EXPECT_GE(steps, 50);  // the step was taken, not only tried
@@ -646,26 +658,12 @@ TEST(HqpInequality, DualStartAgreesWithTheLevelQps) {
   without.setDualStart(false);
   int starts = 0;
   for (int trial = 0; trial < 300; ++trial) {
-    auto L = makeLevels(trial % 4, g);
-    fill(with, L);
-    fill(without, L);
-    with.resetWarmStart();  // the start is tried on empty working sets only
-    without.resetWarmStart();
-    ASSERT_EQ(with.solve(), without.solve()) << "trial " << trial;
-    const auto ref = hqp::testing::bruteForceCascade(L, N);
+    const auto L = makeLevels(trial % 4, g);
+    expectSameAnswer(with, without, L, trial, trial % 4 != 3);  // the reference keeps a dropped level's rows
     for (int p = 0; p < 4; ++p) {
-      const size_t q = static_cast<size_t>(p);
-      starts += with.result().levels[q].dual_start;
-      EXPECT_FALSE(without.result().levels[q].dual_start);
-      EXPECT_EQ(with.result().levels[q].status, without.result().levels[q].status) << "trial " << trial;
-      EXPECT_NEAR(with.result().levels[q].residual, without.result().levels[q].residual,
-                  1e-9 * (1.0 + without.result().levels[q].residual)) << "trial " << trial;
-      if (trial % 4 != 3)  // the reference keeps a dropped level's rows
-        EXPECT_NEAR(with.result().levels[q].residual, ref.residual[q], 1e-8 * (1.0 + ref.residual[q]))
-            << "trial " << trial << " level " << p;
+      starts += with.result().levels[static_cast<size_t>(p)].dual_start;
+      EXPECT_FALSE(without.result().levels[static_cast<size_t>(p)].dual_start);
     }
-    EXPECT_LE((with.result().x - without.result().x).cwiseAbs().maxCoeff(),
-              1e-8 * (1.0 + without.result().x.cwiseAbs().maxCoeff())) << "trial " << trial;
   }
   std::printf("dual starts taken: %d of 600 levels (levels 2 and 3)\n", starts);
   EXPECT_GE(starts, 100);  // the start was taken, not only tried
