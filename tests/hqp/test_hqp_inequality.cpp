@@ -470,6 +470,13 @@ TEST(HqpInequality, InfeasibleLevelKeepsHigherLevelsAndReportsIt) {
 // Unit vector e_i of R^N as a row.
 Eigen::RowVectorXd unitRow(int i) { return Eigen::RowVectorXd::Unit(N, i); }
 
+// The cascade (level 1 solves with its rows), without warm starts: where the routes of the
+// least-distance and dual-start tests are tried.
+void cascadeCold(Wbc& w) {
+  w.setDeferConstraints(false);
+  w.setWarmStart(false);
+}
+
 // Level 1 (index 0) fixes x0 = x1 = 1. Level 2 (index 1): x4 = 1, x5 = 1 with x2 + x3 ≥ 2; its
 // unconstrained minimum-norm step (x2 = x3 = x6 = 0) breaks the row, and its null space
 // (x2, x3, x6) fits the last level's dual solver (3 variables: the last level's task rows).
@@ -509,10 +516,8 @@ std::vector<hqp::testing::RefLevel> leastDistanceLevels(bool reachable) {
 
 TEST(HqpInequality, LeastDistanceStepGivesTheLevelsMinimumNormOptimum) {
   static Wbc with, without;
-  for (Wbc* w : {&with, &without}) {
-    w->setDeferConstraints(false);  // the cascade: level 1 solves with its rows
-    w->setWarmStart(false);
-  }
+  cascadeCold(with);
+  cascadeCold(without);
   without.setLeastDistanceStep(false);
   Eigen::Matrix<double, N, 1> expect;
   expect << 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 0.0;
@@ -578,10 +583,8 @@ void expectSameAnswer(Wbc& with, Wbc& without, const std::vector<hqp::testing::R
 TEST(HqpInequality, LeastDistanceStepAgreesWithTheLevelQps) {
   std::mt19937 g(31);
   static Wbc with, without;
-  for (Wbc* w : {&with, &without}) {
-    w->setDeferConstraints(false);
-    w->setWarmStart(false);
-  }
+  cascadeCold(with);
+  cascadeCold(without);
   without.setLeastDistanceStep(false);
   int steps = 0;
   for (int trial = 0; trial < 200; ++trial) {
@@ -607,10 +610,8 @@ TEST(HqpInequality, LeastDistanceStepAgreesWithTheLevelQps) {
 // x0 + x1 = 2, which meets x0 ≥ 1), residual 2² + 2², multiplier 2.
 TEST(HqpInequality, DualStartHandsTheQpTheLevelsActiveRows) {
   static Wbc with, without;
-  for (Wbc* w : {&with, &without}) {
-    w->setDeferConstraints(false);
-    w->setWarmStart(false);
-  }
+  cascadeCold(with);
+  cascadeCold(without);
   without.setDualStart(false);
   auto L = leastDistanceLevels(true);
   for (auto& l : L) {  // only level 2 has rows: x = (1, 1, 0, …) by minimum norm
@@ -651,10 +652,8 @@ TEST(HqpInequality, DualStartHandsTheQpTheLevelsActiveRows) {
 TEST(HqpInequality, DualStartAgreesWithTheLevelQps) {
   std::mt19937 g(47);
   static Wbc with, without;
-  for (Wbc* w : {&with, &without}) {
-    w->setDeferConstraints(false);
-    w->setWarmStart(false);
-  }
+  cascadeCold(with);
+  cascadeCold(without);
   without.setDualStart(false);
   int starts = 0;
   for (int trial = 0; trial < 300; ++trial) {
