@@ -10,7 +10,11 @@
 #       two bench_hqp binaries (e.g. before and after a change) alternated ROUNDS times
 #       (default 5) on one pinned core; prints per family the medians over the rounds and
 #       old/new, and the peers of each binary (BM_PeerWarm, and the corpus peer) as a check
-#       that the machine did not drift between them.
+#       that the machine did not drift between them. OLD_CORPUS_DIR=DIR gives the old binary
+#       another copy of the corpus (below).
+#   bash scripts/corpus.sh v2 DIR    # the corpus as format version 2 into DIR, for a bench_hqp
+#       from before version 3 (e.g. 3c579bd, before the deferred path): the same instances
+#       without the header's defer_constraints field (docs/recording.md)
 # make: one sim_demo recording per `scenario` line (family walker3_scenarios), then hqp_corpus
 # derives the stress and degenerate families from them. JOBS=N simulations at a time (2).
 set -euo pipefail
@@ -62,7 +66,8 @@ case $cmd in
     for r in $(seq 1 "$rounds"); do
       for which in old new; do
         bin=$old; [ $which = new ] && bin=$new
-        HQP_CORPUS_DIR="$out" "${pin[@]}" "$bin" --benchmark_filter="$filter" \
+        dir=$out; [ $which = old ] && dir=${OLD_CORPUS_DIR:-$out}
+        HQP_CORPUS_DIR="$dir" "${pin[@]}" "$bin" --benchmark_filter="$filter" \
           --benchmark_format=json --benchmark_out="$tmp/$which.$r.json" >/dev/null
         echo "round $r: $which done"
       done
@@ -84,8 +89,28 @@ for n in names:
 PY
     rm -rf "$tmp"
     exit 0 ;;
+  v2)
+    dest=${1:?usage: corpus.sh v2 DIR}
+    [ -f "$out/stress.hqprec" ] || bash "$0" make
+    mkdir -p "$dest"
+    python3 - "$out" "$dest" <<'PY'
+import glob, os, struct, sys
+src, dest = sys.argv[1], sys.argv[2]
+for f in sorted(glob.glob(f"{src}/*.hqprec")):
+    d = open(f, "rb").read()
+    version, nx, levels = struct.unpack_from("<Iii", d, 8)
+    if d[:8] != b"HQPPROB\n" or version != 3:
+        sys.exit(f"{f}: not a version 3 recording")
+    # magic, version, nx, levels, task and constraint rows per level, rank_tol, warm_start,
+    # dual_last_level; then version 3's defer_constraints (4 bytes), dropped.
+    at = 8 + 12 + 8 * levels + 8 + 4 + 4
+    open(os.path.join(dest, os.path.basename(f)), "wb").write(
+        d[:8] + struct.pack("<I", 2) + d[12:at] + d[at + 4:])
+    print(f"{dest}/{os.path.basename(f)}: version 2")
+PY
+    exit 0 ;;
   make) ;;
-  *) echo "usage: corpus.sh make|check|oracle|bench [ARGS]|compare OLD NEW [ROUNDS]" >&2; exit 2 ;;
+  *) echo "usage: corpus.sh make|check|oracle|bench [ARGS]|compare OLD NEW [ROUNDS]|v2 DIR" >&2; exit 2 ;;
 esac
 need sim_demo hqp_corpus
 mkdir -p "$out/scenarios"

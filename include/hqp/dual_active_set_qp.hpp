@@ -280,7 +280,7 @@ class DualActiveSetQp {
   // Tolerance of the stationarity check before Optimal (relative to the terms' magnitude).
   static constexpr double kStationarityTol = 1e-8;
   // Relative duality gap accepted where stationarity holds only to the multipliers' size.
-  static constexpr double kGapTol = 1e-7;
+  static constexpr double kGapTol = 1e-6;
   int iterations() const { return iterations_; }
   int numActive() const { return q_; }
   int activeRow(int k) const { return row_(k); }
