@@ -98,7 +98,7 @@ import glob, os, struct, sys
 src, dest = sys.argv[1], sys.argv[2]
 for f in sorted(glob.glob(f"{src}/*.hqprec")):
     d = open(f, "rb").read()
-    version, nx, levels = struct.unpack_from("<Iii", d, 8)
+    version, _, levels = struct.unpack_from("<Iii", d, 8)
     if d[:8] != b"HQPPROB\n" or version != 3:
         sys.exit(f"{f}: not a version 3 recording")
     # magic, version, nx, levels, task and constraint rows per level, rank_tol, warm_start,

@@ -526,6 +526,7 @@ class DualActiveSetQp {
     const auto R = F_.topLeftCorner(n, n).template triangularView<Eigen::Upper>();
     z_.head(n).noalias() = R * x_;
     double scale = z_.head(n).cwiseAbs().maxCoeff() + c_.head(n).cwiseAbs().maxCoeff();
+    const double fs = z_.head(n).norm() + c_.head(n).norm();  // ‖R x‖ + ‖c‖: the objective's scale
     z_.head(n) -= c_.head(n);
     r_.head(n).noalias() = R.transpose() * z_.head(n);
     double rn = 0.0;  // ‖R‖₁
@@ -552,8 +553,6 @@ class DualActiveSetQp {
       const int j = row_(k);
       gap += u_(k) * std::abs(cx_(j) - (upper_(k) ? upper(j) : lower(j)));
     }
-    z_.head(n).noalias() = R * x_;
-    const double fs = z_.head(n).norm() + c_.head(n).norm();  // ‖R x‖ + ‖c‖: the objective's scale
     return gap <= kGapTol * 0.5 * fs * fs ? QpStatus::Optimal : QpStatus::NumericalFailure;
   }
 
