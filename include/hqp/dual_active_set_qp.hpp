@@ -497,8 +497,66 @@ class DualActiveSetQp {
     return rho <= 1e-12 * ysum && gap > slack + rho * X;
   }
 
-  // The final check before Optimal, O(m n + n² + q n): x finite, every row (both sides, active
-  // rows included) within feasibility_tol · (1 + |ĉ x|), active rows that close to their bound, and the stationarity residual
+  // The final check's rows, with cx_ = C x: every row (both sides, active rows included)
+  // within tol · (1 + |ĉ x|) scaled to a unit row, and the active rows that close to their
+  // bound (complementarity: a nearly singular active set blows the multipliers up (1e30) and
+  // x far out, where an "active" row ends up off its bound).
+  template <class MatC, class VecL, class VecU>
+  bool rowsHold(const MatC& C, const VecL& lower, const VecU& upper, int m, double tol) {
+    cx_.head(m).noalias() = C.topLeftCorner(m, n_) * x_;
+    for (int j = 0; j < m; ++j) {
+      const double v = cx_(j) * rinv_(j), t = tol * (1.0 + std::abs(v));
+      if (!((lower(j) * rinv_(j) - v) <= t) || !((v - upper(j) * rinv_(j)) <= t)) return false;
+    }
+    for (int k = 0; k < q_; ++k) {
+      const int j = row_(k);
+      const double v = cx_(j) * rinv_(j), bnd = (upper_(k) ? upper(j) : lower(j)) * rinv_(j);
+      if (!(std::abs(v - bnd) <= tol * (1.0 + std::abs(v)))) return false;
+    }
+    return true;
+  }
+
+  // One step of iterative refinement where rowsHold failed (cx_ = C x): on a nearly dependent
+  // active set a row held by the others (or an active one) can end a few tol off its bound,
+  // the rounding of the active rows magnified by their ~1/σ_min combination (1e-8 on a unit
+  // row of a stress instance, tol 1e-9). The residuals e of the active rows and of the rows
+  // off their bounds by more than tol / 10 (at the crossed side), computed in x, are taken
+  // out by the smallest correction in w = R (x − x0): Ĝ δw = e with ĝ = R⁻ᵀcᵀ, the
+  // minimum-norm least-squares solution by a rank-revealing (pivoted) decomposition, so that a
+  // dependent row's residual is shared rather than forced; x += R⁻¹ δw. The gradient moves by
+  // Rᵀδw, in the span of those rows: verified() still checks stationarity and the gap. False
+  // if more than 2n rows need it (x unchanged).
+  template <class MatC, class VecL, class VecU>
+  bool refine(const MatC& C, const VecL& lower, const VecU& upper, int m, double tol) {
+    const int n = n_;
+    const auto Rinv = Jr_.topLeftCorner(n, n);  // upper triangular, zero below (factorize)
+    int rows = 0;
+    const auto add = [&](int j, double bound) {
+      if (rows >= 2 * n) return false;
+      np_.head(n).noalias() = Rinv.transpose() * C.row(j).head(n).transpose();  // R⁻ᵀcᵀ
+      const double gn = np_.head(n).norm();
+      if (!(gn > 0.0)) return true;  // a zero row: nothing to correct
+      Gr_.row(rows).head(n) = np_.head(n).transpose() / gn;
+      er_(rows) = (bound - cx_(j)) / gn;
+      ++rows;
+      return true;
+    };
+    for (int k = 0; k < q_; ++k)
+      if (!add(row_(k), upper_(k) ? upper(row_(k)) : lower(row_(k)))) return false;
+    for (int j = 0; j < m; ++j) {
+      if (active_(j) == 1) continue;
+      const double v = cx_(j) * rinv_(j), t = 0.1 * tol * (1.0 + std::abs(v));
+      const bool lo = lower(j) * rinv_(j) - v > t, up = v - upper(j) * rinv_(j) > t;
+      if ((lo || up) && !add(j, lo ? lower(j) : upper(j))) return false;
+    }
+    if (rows == 0) return false;
+    detail::qpMinNormPivoted(Gr_, rows, n, er_, z_, 1e-12, refine_ws_);
+    x_.noalias() += Rinv * z_.head(n);
+    return x_.allFinite();
+  }
+
+  // The final check before Optimal, O(m n + n² + q n): x finite, the rows as rowsHold checks
+  // them (after up to two refine() steps where they fail), and the stationarity residual
   // RᵀR x − Rᵀ(Q_Aᵀ b) + Σ ±u_k c_k = Aᵀ(A x − b) + Σ ±u_k c_k at rounding level relative to
   // the gradient's terms, or else relative to its terms with the multipliers' and a duality
   // gap of at most kGapTol. Rounding with a nearly singular A shows up here rather than as a
@@ -508,20 +566,11 @@ class DualActiveSetQp {
                     const QpSettings& settings) {
     const int n = n_;
     if (!x_.allFinite()) return QpStatus::NumericalFailure;
-    cx_.head(m).noalias() = C.topLeftCorner(m, n) * x_;
-    for (int j = 0; j < m; ++j) {
-      const double v = cx_(j) * rinv_(j);
-      const double t = settings.feasibility_tol * (1.0 + std::abs(v));
-      if (!((lower(j) * rinv_(j) - v) <= t) || !((v - upper(j) * rinv_(j)) <= t))
-        return QpStatus::NumericalFailure;
-    }
-    // Active rows at their bounds (complementarity): a nearly singular active set blows the
-    // multipliers up (1e30) and x far out, where an "active" row ends up off its bound.
-    for (int k = 0; k < q_; ++k) {
-      const int j = row_(k);
-      const double v = cx_(j) * rinv_(j), bnd = (upper_(k) ? upper(j) : lower(j)) * rinv_(j);
-      if (!(std::abs(v - bnd) <= settings.feasibility_tol * (1.0 + std::abs(v)))) return QpStatus::NumericalFailure;
-    }
+    bool held = rowsHold(C, lower, upper, m, settings.feasibility_tol);
+    for (int pass = 0; pass < 2 && !held; ++pass)
+      held = refine(C, lower, upper, m, settings.feasibility_tol) &&
+             rowsHold(C, lower, upper, m, settings.feasibility_tol);
+    if (!held) return QpStatus::NumericalFailure;
     // g = Rᵀ(R x − c), R upper triangular in F_.
     const auto R = F_.topLeftCorner(n, n).template triangularView<Eigen::Upper>();
     z_.head(n).noalias() = R * x_;
@@ -571,6 +620,9 @@ class DualActiveSetQp {
   Eigen::Matrix<double, 2 * MaxIneq, 1> ldp_scale_;  // its columns: the row's ‖R⁻ᵀcᵀ‖
   Eigen::Matrix<int, 2 * MaxIneq, 1> ldp_row_;       // row j at lower: j, at upper: −1 − j
   Eigen::Matrix<int, MaxN, 1> order_;                // solveOrderFree(): the dual method's order
+  Eigen::Matrix<double, 2 * MaxN, MaxN> Gr_;          // refine(): its rows' R⁻ᵀcᵀ
+  Eigen::Matrix<double, 2 * MaxN, 1> er_;             // and residuals
+  detail::QpMinNormWorkspace<2 * MaxN, MaxN> refine_ws_;
 };
 
 }  // namespace hqp

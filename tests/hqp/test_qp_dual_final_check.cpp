@@ -91,6 +91,25 @@ TEST(QpDualFinalCheck, RecordedNearlyDependentVertexIsNotCalledOptimalAboveTheOp
   std::printf("routes ending Optimal: %d of 2\n", optimal);
 }
 
+// The same level as the dual method sees it on the shipped path in a clang -march=native build.
+// Row 29 depends on the active rows through the nearly opposite pair 21, 26 (cos −1 + 4e-8), so
+// their rounding, magnified by a ~1e7 combination, leaves it 1e-8 off its bound (tol 1e-9):
+// every route used to end NumericalFailure there, and the last level with them. The final
+// check's refinement (DualActiveSetQp::refine) takes such residuals out. The optimum,
+// 402.041625, is the primal method's point (that row 1e-8 off) and SciPy's SLSQP's.
+TEST(QpDualFinalCheck, HeldRowOffItsBoundByRoundingIsRefinedToTheOptimum) {
+  const RecordedQp q = readQp(HQP_DUAL_HELD_ROW_QP_FILE);
+  ASSERT_EQ(q.n, 9);
+  ASSERT_EQ(q.m, 30);
+  constexpr double kOptimum = 402.041625;
+  hqp::DualActiveSetQp<15, 15, 60> qp;
+  ASSERT_TRUE(qp.factorize(q.A, q.b, q.r, q.n, q.min_sigma));
+  ASSERT_EQ(qp.solveOrderFree(q.C, q.lower, q.upper, q.m, {}), hqp::QpStatus::Optimal);
+  const Eigen::VectorXd x = qp.x().head(q.n);
+  EXPECT_LE(violation(q, x), 1e-9 * (1.0 + x.norm()));
+  EXPECT_NEAR((q.A * x - q.b).squaredNorm(), kOptimum, 1e-6 * kOptimum);
+}
+
 // min ½‖x − (0, 10)‖² s.t. x1 ≤ 0, −x1 + δ x2 ≤ 0 (δ = 1e-7): the optimum is the apex x = 0
 // (objective ½ · 100) with multipliers 10/δ = 1e8 on both rows (closed form of g + Σ μ c = 0).
 // The multipliers are huge but right: the check must keep calling it Optimal. (At δ = 1e-9 the
