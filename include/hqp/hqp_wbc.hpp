@@ -1180,8 +1180,9 @@ class HqpWbc {
   // After freeStep<P> found that u' = [y; 0] breaks a row (ys_ = y, tmp_ = C₁ y): the minimum-norm
   // point of the level's unconstrained minimizers {[y; v]} that meets every row of levels ≤ p,
   //   min ½‖v‖²  s.t.  lower − dx − C₁ y ≤ C₂ v ≤ upper − dx − C₁ y   (C = [C₁ C₂] rotated),
-  // by the dual method from v = 0 (HqpSettings::least_distance_step; only if v fits in the
-  // last level's dual solver, n − k ≤ dual_variables). A row with no part in
+  // by the dual method from v = 0 (HqpSettings::least_distance_step; by the last level's dual
+  // solver if v fits in it, n − k ≤ dual_variables, else by the dual start's: on level 1 of the
+  // balance hierarchy, 24 variables). A row with no part in
   // v (locked: the higher levels fix it) must already hold. Above the last level only (its
   // rows below are rotated); not on the deferred path (its levels check no row). On success
   // u_ = [y; v], lr.iterations = the dual method's; false (u_ untouched, lr.iterations the
@@ -1194,20 +1195,29 @@ class HqpWbc {
       constexpr int c0 = constraint_offset[P];
       constexpr int c = constraint_offset[P + 1];
       const int m = n - k;
-      if (!settings_.least_distance_step || deferred_ || m <= 0 || m > dual_variables) return false;
+      constexpr bool start_solver = !std::is_same_v<StartQp, detail::NoQp>;
+      if (!settings_.least_distance_step || deferred_ || m <= 0) return false;
+      if (m > dual_variables && !start_solver) return false;
       const auto Cw = W_.block(total_task_rows, col0, c, n);
       const auto Cv = Cw.middleCols(k, m);
       for (int i = 0; i < c; ++i)
         if (!dualRowBounds(i, ownBegin(c0), tmp_(i), Cv.row(i).squaredNorm(), true)) return false;
-      if (!dual_.factorizeIdentity(m)) return false;
-      const QpStatus s = dual_.solve(Cv, dlo_, dup_, c, settings_.qp);
-      lr.iterations = dual_.iterations();
-      if (s != QpStatus::Optimal) return false;
-      u_.setZero(n);
-      u_.head(k) = ys_.head(k);
-      u_.segment(k, m) = dual_.x();
-      lr.least_distance = true;
-      return true;
+      // The last level's solver where v fits in it, else the dual start's (Nx variables).
+      const auto run = [&](auto& dual) {
+        if (!dual.factorizeIdentity(m)) return false;
+        const QpStatus s = dual.solve(Cv, dlo_, dup_, c, settings_.qp);
+        lr.iterations = dual.iterations();
+        if (s != QpStatus::Optimal) return false;
+        u_.setZero(n);
+        u_.head(k) = ys_.head(k);
+        u_.segment(k, m) = dual.x();
+        return true;
+      };
+      bool ok = false;
+      if (m <= dual_variables) ok = run(dual_);
+      else if constexpr (start_solver) ok = run(start_);
+      lr.least_distance = ok;
+      return ok;
     }
   }
 
