@@ -622,7 +622,7 @@ class DualActiveSetQp {
   Eigen::Matrix<int, MaxN, 1> order_;                // solveOrderFree(): the dual method's order
   Eigen::Matrix<double, 2 * MaxN, MaxN> Gr_;          // refine(): its rows' R⁻ᵀcᵀ
   Eigen::Matrix<double, 2 * MaxN, 1> er_;             // and residuals
-  detail::QpMinNormWorkspace<2 * MaxN, MaxN> refine_ws_;
+  detail::QpMinNormWorkspace<MaxN, MaxN> refine_ws_;  // the pivoted path sizes it by n alone
 };
 
 }  // namespace hqp
