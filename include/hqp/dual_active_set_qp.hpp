@@ -388,23 +388,6 @@ class DualActiveSetQp {
       active_(j) = 1;
       ++q_;
     }
-    // Refinement on the active rows: w's rounding, magnified by R⁻¹, leaves them off their
-    // bounds by up to ε ‖w‖ ‖R⁻ᵀcᵀ‖ / ‖c‖ (3e-8 per unit row on a stress instance). Their
-    // residuals e, computed in x, are taken out by the smallest correction in w (Ĝ_A δw = e
-    // scaled as the rows, x += R⁻¹ δw: δw in the span of the active ĝ keeps stationarity).
-    // Twice; not where the active ĝ are dependent to 1e-12. Scratch: Ra_ (Ĝ_Aᵀ and its QR),
-    // np_ (its reflectors), r_ (e), all solve()'s.
-    for (int pass = 0; pass < 2 && q_ > 0 && q_ <= n; ++pass) {
-      for (int k = 0; k < q_; ++k) {
-        const int col = ldp_.passive(k), j = row_(k);
-        const double bound = upper_(k) ? upper(j) : lower(j);
-        Ra_.col(k).head(n) = E.col(col).head(n);
-        r_(k) = (upper_(k) ? -1.0 : 1.0) * (bound - C.row(j).head(n).dot(x_)) / ldp_scale_(col);
-      }
-      if (!detail::qpHouseholderQr(Ra_, n, q_, 1e-12, np_, d_)) break;
-      detail::qpMinNormFromTransposedQr(Ra_, n, q_, np_, r_, z_);  // δw = Q [R⁻ᵀ e; 0]
-      x_.noalias() += Rinv * z_.head(n);
-    }
     return verified(C, lower, upper, m, settings);
   }
 
