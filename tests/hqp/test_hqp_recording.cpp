@@ -246,6 +246,54 @@ TEST(Recording, CertificateOnIllConditionedLevelsPassesOnlyTheOptimum) {
   EXPECT_EQ(wrong, 0);
 }
 
+// Stress instances 201, 221 and 265 of the corpus: level 2's contact target is out of reach, so
+// its least-distance step fails and the dual start (from that step's active rows) sets the QP's
+// working set. Every level must end at the optimum that the primal route alone reaches (no
+// least-distance step, no dual start, no dual last level, no deferred attempt), level by level.
+TEST(Recording, OutOfReachLevelReachesTheOptimumOfThePrimalRoute) {
+  hqp::ProblemFileInfo info;
+  const auto v = hqp::readProblemFile<Replay>(HQP_OUT_OF_REACH_FILE, &info);
+  ASSERT_EQ(v.size(), 3u);
+  hqp::HqpSettings primal = info.shippedSettings();
+  primal.least_distance_step = false;
+  primal.dual_start = false;
+  primal.dual_last_level = false;
+  primal.defer_constraints = false;
+  auto wbc = std::make_unique<Replay>(info.shippedSettings());
+  auto ref = std::make_unique<Replay>(primal);
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    const Instance& in = v[k];
+    for (const bool warm : {true, false}) {
+      hqp::loadInstance(in, *wbc, warm);
+      wbc->solve();
+      hqp::loadInstance(in, *ref, warm);
+      ref->solve();
+      const auto& r = wbc->result();
+      const auto& l2 = r.levels[1];
+      EXPECT_FALSE(l2.least_distance) << k;  // the step was tried and failed ...
+      EXPECT_TRUE(l2.dual_start) << k;       // ... and the dual start ran
+      EXPECT_FALSE(ref->result().levels[1].dual_start) << k;
+      for (int p = 0; p < Replay::num_levels; ++p) {
+        ASSERT_EQ(r.levels[p].status, hqp::QpStatus::Optimal) << k << " level " << p;
+        ASSERT_EQ(ref->result().levels[p].status, hqp::QpStatus::Optimal) << k << " level " << p;
+        double f = 0.0, g = 0.0;
+        for (int i = Replay::task_offset[p]; i < Replay::task_offset[p + 1]; ++i) {
+          const double e = in.A.row(i).dot(r.x) - in.b(i), e0 = in.A.row(i).dot(ref->x()) - in.b(i);
+          f += in.w(i) * e * e;
+          g += in.w(i) * e0 * e0;
+        }
+        EXPECT_NEAR(f, g, 1e-7 * (1.0 + g)) << k << " level " << p << " warm " << warm;
+      }
+      for (int i = 0; i < Replay::total_constraint_rows; ++i) {
+        const double d = in.D.row(i).dot(r.x);
+        const double tol = 1e-9 * (1.0 + std::abs(d)) * std::max(1.0, in.D.row(i).norm());
+        EXPECT_GE(d, in.lower(i) - tol) << k << " row " << i;
+        EXPECT_LE(d, in.upper(i) + tol) << k << " row " << i;
+      }
+    }
+  }
+}
+
 TEST(Recording, FileRoundTripIsExact) {
   const std::string bytes = hqp::problem_file::readWholeFile(HQP_RECORDING_FILE);
   hqp::ProblemFileInfo info;
