@@ -1462,7 +1462,7 @@ class HqpWbc {
   std::array<bool, max_active> start_upper_{};
   VectorC dlo_ = VectorC::Zero(), dup_ = VectorC::Zero();  // its bounds
   int ld_rows_ = 0;  // a failed least-distance step's active rows, first in prefer_
-  std::array<int, Nx> prefer_{};                            // its warm start
+  std::array<int, Nx> prefer_{};  // rows a dual solve adds first (its warm start, dualStart's)
   LeastSquares ls_;
   std::array<NullSpace<capacity(max_task_rows), Nx>, sizeof...(Levels)> ns_{};  // per level: Q_p
   std::array<bool, sizeof...(Levels)> slack_{};
