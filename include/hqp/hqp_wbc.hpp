@@ -652,6 +652,7 @@ class HqpWbc {
 
   template <int P>
   void solveLevel() {
+    ld_rows_ = 0;  // only this level's failed least-distance step may seed its dual start
     constexpr int r = LevelType<P>::task_rows;
     constexpr int t0 = task_offset[P];
     constexpr int c0 = constraint_offset[P];
@@ -1157,7 +1158,6 @@ class HqpWbc {
     constexpr int c0 = constraint_offset[P];
     constexpr int c = constraint_offset[P + 1];
     constexpr int rows0 = total_task_rows;  // first constraint row in W_
-    ld_rows_ = 0;
     if (!unconstrainedStep<P>(k)) return false;
     // Constraint rows times u': rotated rows see [y; 0]; unrotated ones Q [y; 0].
     auto Cw = W_.block(rows0, col0, c, n);
@@ -1461,7 +1461,7 @@ class HqpWbc {
   std::array<int, max_active> start_row_{};
   std::array<bool, max_active> start_upper_{};
   VectorC dlo_ = VectorC::Zero(), dup_ = VectorC::Zero();  // its bounds
-  int ld_rows_ = 0;  // a failed least-distance step's active rows, first in prefer_
+  int ld_rows_ = 0;  // this level's failed least-distance step's active rows, first in prefer_
   std::array<int, Nx> prefer_{};  // rows a dual solve adds first (its warm start, dualStart's)
   LeastSquares ls_;
   std::array<NullSpace<capacity(max_task_rows), Nx>, sizeof...(Levels)> ns_{};  // per level: Q_p

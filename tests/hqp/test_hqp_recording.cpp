@@ -155,12 +155,14 @@ const std::vector<Instance>& stressCases(hqp::ProblemFileInfo* info) {
 }
 constexpr double kStressOptimum[3] = {1977.0146988, 1646.1729438, 6255.8395690};  // 185, 108, 274
 
-// Level 4's weighted residual Σ w (a x − b)² at x, from the instance's own rows.
+// Level p's weighted residual Σ w (a x − b)² at x, from the instance's own rows.
+double levelObjective(const Instance& in, const Replay::VectorX& x, int p) {
+  const int t = Replay::task_offset[p], rows = Replay::task_offset[p + 1] - t;
+  const Eigen::VectorXd e = in.A.middleRows(t, rows) * x - in.b.segment(t, rows);
+  return (e.array().square() * in.w.segment(t, rows).array()).sum();
+}
 double lastLevelObjective(const Instance& in, const Replay::VectorX& x) {
-  constexpr int t3 = Replay::task_offset[3];
-  constexpr int r3 = Replay::total_task_rows - t3;
-  const Eigen::VectorXd e = in.A.middleRows(t3, r3) * x - in.b.segment(t3, r3);
-  return (e.array().square() * in.w.segment(t3, r3).array()).sum();
+  return levelObjective(in, x, Replay::num_levels - 1);
 }
 
 TEST(Recording, IllConditionedLastLevelReachesItsOptimum) {
@@ -276,12 +278,7 @@ TEST(Recording, OutOfReachLevelReachesTheOptimumOfThePrimalRoute) {
       for (int p = 0; p < Replay::num_levels; ++p) {
         ASSERT_EQ(r.levels[p].status, hqp::QpStatus::Optimal) << k << " level " << p;
         ASSERT_EQ(ref->result().levels[p].status, hqp::QpStatus::Optimal) << k << " level " << p;
-        double f = 0.0, g = 0.0;
-        for (int i = Replay::task_offset[p]; i < Replay::task_offset[p + 1]; ++i) {
-          const double e = in.A.row(i).dot(r.x) - in.b(i), e0 = in.A.row(i).dot(ref->x()) - in.b(i);
-          f += in.w(i) * e * e;
-          g += in.w(i) * e0 * e0;
-        }
+        const double f = levelObjective(in, r.x, p), g = levelObjective(in, ref->x(), p);
         EXPECT_NEAR(f, g, 1e-7 * (1.0 + g)) << k << " level " << p << " warm " << warm;
       }
       for (int i = 0; i < Replay::total_constraint_rows; ++i) {
