@@ -38,12 +38,42 @@ class DualActiveSetQp {
   // that violates a row; the final check of solve() catches the latter, this the former.
   static constexpr double kMinSigmaFloor = 1e-9;
 
+  // Every input as a map: the column-major data the callers hold (a matrix, a block of
+  // one, or a single row) without a copy; checked at compile time.
+  using ColumnsMap = Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
+  using VectorMap = Eigen::Map<const Eigen::VectorXd>;
+  template <class Mat>
+  static ColumnsMap mapColumns(const Mat& M) noexcept {
+    static_assert((Mat::Flags & Eigen::DirectAccessBit) != 0, "a matrix or a block of one");
+    if constexpr (Mat::RowsAtCompileTime == 1) {  // one row: its entries' stride
+      return ColumnsMap(M.data(), 1, M.cols(), Eigen::OuterStride<>(M.innerStride()));
+    } else {
+      static_assert(!(Mat::Flags & Eigen::RowMajorBit) && Mat::InnerStrideAtCompileTime == 1,
+                    "column-major, inner stride 1");
+      return ColumnsMap(M.data(), M.rows(), M.cols(), Eigen::OuterStride<>(M.outerStride()));
+    }
+  }
+  template <class Vec>
+  static VectorMap mapVector(const Vec& v) noexcept {
+    static_assert((Vec::Flags & Eigen::DirectAccessBit) && Vec::InnerStrideAtCompileTime == 1,
+                  "a contiguous vector");
+    return VectorMap(v.data(), v.size());
+  }
+
   // Factorizes A (rows r ≥ n, n columns) and forms the unconstrained minimizer R⁻¹ (Q_Aᵀ b).
   // Returns false, and nothing is valid (solve() then returns InvalidInput), unless A and b
   // are finite and 1/‖R⁻¹‖_F > max(min_sigma, kMinSigmaFloor · ‖A‖_F), a lower bound of
   // σ_min(A): the objective is then strictly convex by at least that margin.
   template <class MatA, class VecB>
   bool factorize(const MatA& A, const VecB& b, int r, int n, double min_sigma) noexcept {
+    return factorizeMapped(mapColumns(A), mapVector(b), r, n, min_sigma);
+  }
+
+  // factorize() on A and b as maps: the method's code is compiled once per solver type,
+  // whatever block or matrix type the caller holds its data in (docs/hqp.md, "One copy of
+  // the dual method's code").
+  bool factorizeMapped(const ColumnsMap& A, const VectorMap& b, int r, int n,
+                       double min_sigma) noexcept {
     n_ = n;
     factorized_ = false;
     if (n <= 0 || n > MaxN || r < n || r > MaxRows) return false;
@@ -151,6 +181,13 @@ class DualActiveSetQp {
   QpStatus solve(const MatC& C, const VecL& lower, const VecU& upper, int m,
                  const QpSettings& settings, const int* prefer = nullptr,
                  int prefer_count = 0) noexcept {
+    return solveMapped(mapColumns(C), mapVector(lower), mapVector(upper), m, settings, prefer,
+                       prefer_count);
+  }
+
+  QpStatus solveMapped(const ColumnsMap& C, const VectorMap& lower, const VectorMap& upper,
+                       int m, const QpSettings& settings, const int* prefer = nullptr,
+                       int prefer_count = 0) noexcept {
     const int n = n_;
     const QpStatus in = start(C, lower, upper, m, settings);
     if (in != QpStatus::Optimal) return in;
@@ -245,6 +282,11 @@ class DualActiveSetQp {
   template <class MatC, class VecL, class VecU>
   QpStatus solveOrderFree(const MatC& C, const VecL& lower, const VecU& upper, int m,
                           const QpSettings& settings) noexcept {
+    return solveOrderFreeMapped(mapColumns(C), mapVector(lower), mapVector(upper), m, settings);
+  }
+  QpStatus solveOrderFreeMapped(const ColumnsMap& C, const VectorMap& lower,
+                                const VectorMap& upper, int m,
+                                const QpSettings& settings) noexcept {
     QpStatus s = QpStatus::NumericalFailure;
     int its = 0;
     for (const double dependent : {std::sqrt(std::numeric_limits<double>::epsilon()), 1e-12}) {
@@ -256,7 +298,7 @@ class DualActiveSetQp {
       for (int k = 0; k < cnt; ++k) order_(k) = row_(k);
       // J = R⁻¹ as factorize() left it (the caller's solve() rotated it; F_, Jr_, x0_ hold).
       J_.topLeftCorner(n_, n_) = Jr_.topLeftCorner(n_, n_).template triangularView<Eigen::Upper>();
-      s = solve(C, lower, upper, m, settings, order_.data(), cnt);
+      s = solveMapped(C, lower, upper, m, settings, order_.data(), cnt);
       its += iterations_;
       if (s == QpStatus::Optimal) break;
     }

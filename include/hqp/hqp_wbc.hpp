@@ -230,21 +230,15 @@ class HqpWbc {
   static constexpr bool has_slack_levels =
       ((Levels::slack && Levels::constraint_rows > 0) || ...);
   static constexpr int max_slack_rows = detail::maxSlackRows<Levels...>();
-  // The last level's dual solver (HqpSettings::dual_last_level): it sees at most as many
-  // variables as the level has task rows. The least-distance step (HqpSettings::
-  // least_distance_step) uses it too, on levels whose null space fits in that size: sized for
-  // Nx instead, the last level's solve measured a few per cent slower (docs/benchmarks.md), and
-  // a second solver type would cost compile time in every unit.
+  // The dual method's solver, one object for its three uses, which never overlap within a level
+  // and hand nothing on but rows copied out: the last level (HqpSettings::dual_last_level,
+  // at most Nx variables and its task rows), the least-distance step (least_distance_step,
+  // a level's null-space part) and the dual start (dual_start, a level's variables, its task
+  // rows plus one per null-space variable). One type sized for the largest use: the method's
+  // code is compiled once (docs/hqp.md, "One copy of the dual method's code").
   static constexpr int last_task_rows = LevelType<sizeof...(Levels) - 1>::task_rows;
-  static constexpr int dual_variables = std::min(Nx, last_task_rows);
   using DualQp = std::conditional_t<
-      (total_constraint_rows > 0 && last_task_rows > 0),
-      DualActiveSetQp<dual_variables, last_task_rows, capacity(total_constraint_rows)>,
-      detail::NoQp>;
-  // The dual start's solver (HqpSettings::dual_start): a level's variables (up to Nx), the
-  // level's task rows plus one row per null-space variable. Levels between the first and last.
-  using StartQp = std::conditional_t<
-      (total_constraint_rows > 0 && sizeof...(Levels) > 2),
+      (total_constraint_rows > 0 && (last_task_rows > 0 || sizeof...(Levels) > 2)),
       DualActiveSetQp<Nx, Nx + capacity(max_task_rows), capacity(total_constraint_rows)>,
       detail::NoQp>;
   using SlackQp = std::conditional_t<
@@ -777,7 +771,7 @@ class HqpWbc {
       const bool locked_infeasible = neutralizeLockedRows(qp, c, ownBegin(c0));
       QpStatus s = QpStatus::Infeasible;
       bool warm = settings_.warm_start;
-      if constexpr (P > 0 && !last && !std::is_same_v<StartQp, detail::NoQp>) {
+      if constexpr (P > 0 && !last && !std::is_same_v<DualQp, detail::NoQp>) {
         if (!locked_infeasible && !deferred_ && settings_.dual_start && qp.numActive() == 0 &&
             dualStart<P>(qp, n, k, c, lr))
           warm = true;  // the working set just set
@@ -1188,9 +1182,7 @@ class HqpWbc {
   // After freeStep<P> found that u' = [y; 0] breaks a row (ys_ = y, tmp_ = C₁ y): the minimum-norm
   // point of the level's unconstrained minimizers {[y; v]} that meets every row of levels ≤ p,
   //   min ½‖v‖²  s.t.  lower − dx − C₁ y ≤ C₂ v ≤ upper − dx − C₁ y   (C = [C₁ C₂] rotated),
-  // by the dual method from v = 0 (HqpSettings::least_distance_step; by the last level's dual
-  // solver if v fits in it, n − k ≤ dual_variables, else by the dual start's: on level 1 of the
-  // balance hierarchy, 24 variables). A row with no part in
+  // by the dual method from v = 0 (HqpSettings::least_distance_step). A row with no part in
   // v (locked: the higher levels fix it) must already hold. Above the last level only (its
   // rows below are rotated); not on the deferred path (its levels check no row). On success
   // u_ = [y; v], lr.iterations = the dual method's; false (u_ untouched, lr.iterations the
@@ -1203,36 +1195,27 @@ class HqpWbc {
       constexpr int c0 = constraint_offset[P];
       constexpr int c = constraint_offset[P + 1];
       const int m = n - k;
-      constexpr bool start_solver = !std::is_same_v<StartQp, detail::NoQp>;
       if (!settings_.least_distance_step || deferred_ || m <= 0) return false;
-      if (m > dual_variables && !start_solver) return false;
       const auto Cw = W_.block(total_task_rows, col0, c, n);
       const auto Cv = Cw.middleCols(k, m);
       for (int i = 0; i < c; ++i)
         if (!dualRowBounds(i, ownBegin(c0), tmp_(i), Cv.row(i).squaredNorm(), true)) return false;
-      // The last level's solver where v fits in it, else the dual start's (Nx variables).
-      const auto run = [&](auto& dual) {
-        if (!dual.factorizeIdentity(m)) return false;
-        const QpStatus s = dual.solve(Cv, dlo_, dup_, c, settings_.qp);
-        lr.iterations = dual.iterations();
-        if (s != QpStatus::Optimal) {
-          // The dual start would retrace this path before it moves the task's part: it adds
-          // these rows first (dualStart).
-          ld_rows_ = std::min(dual.numActive(), static_cast<int>(prefer_.size()));
-          for (int a = 0; a < ld_rows_; ++a)
-            prefer_[static_cast<std::size_t>(a)] = dual.activeRow(a);
-          return false;
-        }
-        u_.setZero(n);
-        u_.head(k) = ys_.head(k);
-        u_.segment(k, m) = dual.x();
-        return true;
-      };
-      bool ok = false;
-      if (m <= dual_variables) ok = run(dual_);
-      else if constexpr (start_solver) ok = run(start_);
-      lr.least_distance = ok;
-      return ok;
+      if (!dual_.factorizeIdentity(m)) return false;
+      const QpStatus s = dual_.solve(Cv, dlo_, dup_, c, settings_.qp);
+      lr.iterations = dual_.iterations();
+      if (s != QpStatus::Optimal) {
+        // The dual start would retrace this path before it moves the task's part: it adds
+        // these rows first (dualStart).
+        ld_rows_ = std::min(dual_.numActive(), static_cast<int>(prefer_.size()));
+        for (int a = 0; a < ld_rows_; ++a)
+          prefer_[static_cast<std::size_t>(a)] = dual_.activeRow(a);
+        return false;
+      }
+      u_.setZero(n);
+      u_.head(k) = ys_.head(k);
+      u_.segment(k, m) = dual_.x();
+      lr.least_distance = true;
+      return true;
     }
   }
 
@@ -1264,15 +1247,15 @@ class HqpWbc {
     for (int i = 0; i < m; ++i) Fs_(r + i, k + i) = sd;
     fs_.setZero(r + m);
     fs_.head(r) = qp.b();
-    if (!start_.factorize(Fs_, fs_, r + m, n, 0.0)) return false;
+    if (!dual_.factorize(Fs_, fs_, r + m, n, 0.0)) return false;
     const QpStatus s =
-        start_.solve(qp.C(), qp.lower(), qp.upper(), c, settings_.qp, prefer_.data(), from_ld);
-    lr.iterations += start_.iterations();
-    if (s != QpStatus::Optimal || start_.numActive() == 0) return false;
-    const int cnt = std::min(start_.numActive(), max_active);
+        dual_.solve(qp.C(), qp.lower(), qp.upper(), c, settings_.qp, prefer_.data(), from_ld);
+    lr.iterations += dual_.iterations();
+    if (s != QpStatus::Optimal || dual_.numActive() == 0) return false;
+    const int cnt = std::min(dual_.numActive(), max_active);
     for (int a = 0; a < cnt; ++a) {
-      start_row_[static_cast<std::size_t>(a)] = start_.activeRow(a);
-      start_upper_[static_cast<std::size_t>(a)] = start_.activeAtUpper(a);
+      start_row_[static_cast<std::size_t>(a)] = dual_.activeRow(a);
+      start_upper_[static_cast<std::size_t>(a)] = dual_.activeAtUpper(a);
     }
     qp.setWorkingSet(cnt, start_row_.data(), start_upper_.data());
     lr.dual_start = true;
@@ -1455,7 +1438,7 @@ class HqpWbc {
   QpTuple qps_;
   SlackQp slack_qp_;
   DualQp dual_;
-  StartQp start_;  // the dual start: its solver, objective [Â Q; 0 √δ I] and b̂, working set
+  // The dual start's objective [Â Q; 0 √δ I] and b̂, and its working set.
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, Nx + capacity(max_task_rows), Nx> Fs_;
   Eigen::Matrix<double, Eigen::Dynamic, 1, 0, Nx + capacity(max_task_rows), 1> fs_;
   std::array<int, max_active> start_row_{};
