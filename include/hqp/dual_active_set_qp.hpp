@@ -38,6 +38,7 @@ class DualActiveSetQp {
   // that violates a row; the final check of solve() catches the latter, this the former.
   static constexpr double kMinSigmaFloor = 1e-9;
 
+ private:
   // Every input as a map: the column-major data the callers hold (a matrix, a block of
   // one, or a single row) without a copy; checked at compile time.
   using ColumnsMap = Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
@@ -60,6 +61,7 @@ class DualActiveSetQp {
     return VectorMap(v.data(), v.size());
   }
 
+ public:
   // Factorizes A (rows r ≥ n, n columns) and forms the unconstrained minimizer R⁻¹ (Q_Aᵀ b).
   // Returns false, and nothing is valid (solve() then returns InvalidInput), unless A and b
   // are finite and 1/‖R⁻¹‖_F > max(min_sigma, kMinSigmaFloor · ‖A‖_F), a lower bound of
@@ -69,6 +71,7 @@ class DualActiveSetQp {
     return factorizeMapped(mapColumns(A), mapVector(b), r, n, min_sigma);
   }
 
+ private:
   // factorize() on A and b as maps: the method's code is compiled once per solver type,
   // whatever block or matrix type the caller holds its data in (docs/hqp.md, "One copy of
   // the dual method's code").
@@ -152,6 +155,8 @@ class DualActiveSetQp {
     return factorized_;
   }
 
+ public:
+
   // The least-distance objective ½‖x‖² (A = I, b = 0) on n variables: what factorize() would
   // compute for it (R = I, J = I, unconstrained minimizer 0) without its O(n³) steps.
   bool factorizeIdentity(int n) noexcept {
@@ -185,6 +190,7 @@ class DualActiveSetQp {
                        prefer_count);
   }
 
+ private:
   QpStatus solveMapped(const ColumnsMap& C, const VectorMap& lower, const VectorMap& upper,
                        int m, const QpSettings& settings, const int* prefer = nullptr,
                        int prefer_count = 0) noexcept {
@@ -270,6 +276,8 @@ class DualActiveSetQp {
     }
   }
 
+ public:
+
   // The same QP by routes that do not depend on an order of the rows, for when solve() ends
   // on nearly dependent rows (NumericalFailure) in the orders the caller tried. Least distance
   // (leastDistance below: the NNLS residual that defines its point is stable where the
@@ -284,6 +292,8 @@ class DualActiveSetQp {
                           const QpSettings& settings) noexcept {
     return solveOrderFreeMapped(mapColumns(C), mapVector(lower), mapVector(upper), m, settings);
   }
+
+ private:
   QpStatus solveOrderFreeMapped(const ColumnsMap& C, const VectorMap& lower,
                                 const VectorMap& upper, int m,
                                 const QpSettings& settings) noexcept {
@@ -305,6 +315,8 @@ class DualActiveSetQp {
     iterations_ = its;
     return s;
   }
+
+ public:
 
   // Warm start from a primal solver's working set (ActiveSetQp's numActive/activeRow,
   // variables/hasWorkingSet): if it belongs to a problem of n variables, its first rows (at
