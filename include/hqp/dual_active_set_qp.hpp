@@ -156,7 +156,6 @@ class DualActiveSetQp {
   }
 
  public:
-
   // The least-distance objective ½‖x‖² (A = I, b = 0) on n variables: what factorize() would
   // compute for it (R = I, J = I, unconstrained minimizer 0) without its O(n³) steps.
   bool factorizeIdentity(int n) noexcept {
@@ -277,7 +276,6 @@ class DualActiveSetQp {
   }
 
  public:
-
   // The same QP by routes that do not depend on an order of the rows, for when solve() ends
   // on nearly dependent rows (NumericalFailure) in the orders the caller tried. Least distance
   // (leastDistance below: the NNLS residual that defines its point is stable where the
@@ -317,7 +315,6 @@ class DualActiveSetQp {
   }
 
  public:
-
   // Warm start from a primal solver's working set (ActiveSetQp's numActive/activeRow,
   // variables/hasWorkingSet): if it belongs to a problem of n variables, its first rows (at
   // most MaxN) are written to rows, to be passed to solve() as prefer. Returns their count.
