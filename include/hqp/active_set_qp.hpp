@@ -159,6 +159,19 @@ class ActiveSetQp {
     }
     have_ws_ = true;
   }
+  // Rows believed to hold at their bounds at the x_init of the next solve (e.g. the rows active
+  // at the point a cascade's level starts from). Used by that solve only, and only if it
+  // starts phase 2 at x_init (no warm working set kept): the rows that hold at x_init to the
+  // feasibility tolerance form its first working set (dependent ones are left out), where
+  // without them it starts with none and re-adds each as a blocking row, one iteration apiece.
+  void setStartRows(int count, const int* rows, const bool* upper) {
+    start_count_ = 0;
+    for (int k = 0; k < count && k < NV; ++k) {
+      start_row_(k) = rows[k];
+      start_upper_(k) = upper[k] ? 1 : 0;
+      ++start_count_;
+    }
+  }
 
  private:
   static constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -285,6 +298,8 @@ class ActiveSetQp {
   Eigen::Matrix<int, NV, 1> ws_upper_;   // side
   Eigen::Matrix<double, NV, 1> ws_mu_;   // reported multipliers (unscaled, ≥ 0)
   Eigen::Matrix<int, NV, 1> ws_prev_row_, ws_prev_upper_;  // warm-start copy
+  Eigen::Matrix<int, NV, 1> start_row_, start_upper_;      // setStartRows()
+  int start_count_ = 0;
   Eigen::Matrix<int, NV, 1> cand_row_, cand_upper_;        // rows addWarmRows tries
   Eigen::Matrix<double, 8, NV> strip_;                     // 8 of their rows, reduced
   Eigen::Matrix<int, MI, 1> in_ws_;
@@ -1349,10 +1364,28 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::solveOnce(const VectorX* x_
       addEqualities();
     }
   }
+  const int start_count = start_count_;
+  start_count_ = 0;
   if (!started && x_init != nullptr && x_init->size() == n_) {
     for (int i = 0; i < n_; ++i) xc_(i) = (*x_init)(i);
     started = xc_.head(n_).allFinite() && maxViolation(xc_) <= settings_.feasibility_tol;
     cx_at_xc_ = started;
+    if (started && start_count > 0) {
+      // setStartRows(): the rows that hold at x_init (maxViolation left cx_ = Ĉ x_init).
+      int cnt = 0;
+      for (int k = 0; k < start_count; ++k) {
+        const int j = start_row_(k);
+        const bool up = start_upper_(k) != 0;
+        if (j < 0 || j >= mi_) continue;
+        const double bound = up ? us_(j) : ls_(j);
+        if (!(std::abs(cx_(j) - bound) <= settings_.feasibility_tol * (1.0 + std::abs(cx_(j)))))
+          continue;
+        ws_prev_row_(cnt) = j;
+        ws_prev_upper_(cnt) = up ? 1 : 0;
+        ++cnt;
+      }
+      if (cnt > 0) addWarmRows(cnt);
+    }
   }
   if (!started) {
     // Minimum-norm point of E x = e (the subproblem with A = 0 would do the same).

@@ -499,6 +499,7 @@ class HqpWbc {
   // The state before level 0: Z_{−1} = I, x*_{−1} = 0. The deferred path copies only the task
   // rows of the levels above the last (deferredRows forms the others from A_ and D_).
   void begin(bool deferred = false) {
+    bound_count_ = 0;
     result_.status = QpStatus::Optimal;
     result_.failed_level = -1;
     x_.setZero();
@@ -647,6 +648,8 @@ class HqpWbc {
   template <int P>
   void solveLevel() {
     ld_rows_ = 0;  // only this level's failed least-distance step may seed its dual start
+    const int bound_above = bound_count_;  // rows at their bounds at x*_{p−1}
+    bound_count_ = 0;
     constexpr int r = LevelType<P>::task_rows;
     constexpr int t0 = task_offset[P];
     constexpr int c0 = constraint_offset[P];
@@ -777,6 +780,9 @@ class HqpWbc {
           warm = true;  // the working set just set
       }
       if (!locked_infeasible) {
+        // u = 0 (x*_{p−1}) holds the rows the level above ended on at their bounds: the
+        // QP's first working set where it starts there (docs/hqp.md, "Start rows").
+        if (bound_above > 0) qp.setStartRows(bound_above, bound_row_.data(), bound_upper_.data());
         s = qp.solve(hint, warm);  // the hint is used only if feasible
         lr.iterations += qp.iterations();  // after a failed least-distance step's, the dual start's
       }
@@ -820,6 +826,11 @@ class HqpWbc {
         lr.active_row[as] = qp.activeRow(a);
         lr.active_upper[as] = qp.activeAtUpper(a);
         lr.multiplier[as] = qp.activeAtUpper(a) ? qp.multiplier(a) : -qp.multiplier(a);
+      }
+      if (lr.status == QpStatus::Optimal && !lr.constraints_dropped) {
+        bound_count_ = std::min(lr.num_active, static_cast<int>(bound_row_.size()));
+        std::copy_n(lr.active_row.begin(), bound_count_, bound_row_.begin());
+        std::copy_n(lr.active_upper.begin(), bound_count_, bound_upper_.begin());
       }
       // The QP's own data (u in its coordinates: u' or, direct, u) and its multipliers.
       if (settings_.kkt_residuals && qp.x().size() == n)
@@ -943,32 +954,24 @@ class HqpWbc {
       if (!dualRowBounds(i, own_begin, 0.0, cnorm_(i), i >= own_begin)) return false;
     }
     // Any order of the violated rows is valid for the dual method, and an order that ends on
-    // nearly dependent rows (NumericalFailure) may be avoided by another, so up to three run
-    // before the general path: the level's working set first (the previous tick's active set,
-    // or a recorded one) or, where it is empty, on the cascade the level above's active set
-    // (its rows hold at x*_{p−1}, and most of them stay active: on the stress family 15 in
-    // place of 17 iterations per instance); then the method's own (most violated first);
-    // then the level above's, if it was not first.
+    // nearly dependent rows (NumericalFailure) may be avoided by another. The first order is the
+    // level's working set (the previous tick's active set, or a recorded one) or, where it is
+    // empty, on the cascade the level above's active set (its rows hold at x*_{p−1}, and most
+    // of them stay active: on the stress family 15 in place of 17 iterations per instance).
+    // On the deferred path the method's own order (most violated first) is the second; on the
+    // cascade a failed first order goes to routes that depend on no order
+    // (DualActiveSetQp::solveOrderFree), before the general path's ActiveSetQp, which can end
+    // on such rows too: there another order met the same rows on every stress instance seen
+    // (docs/benchmarks.md, "The stress tail by phase").
     const auto& above = result_.levels[P > 0 ? P - 1 : 0];
-    const bool above_rows = P > 0 && !deferred_ && above.num_active > 0;
-    const auto preferAbove = [&] {
-      const int cnt = std::min(above.num_active, static_cast<int>(prefer_.size()));
-      std::copy_n(above.active_row.begin(), cnt, prefer_.begin());
-      return cnt;
-    };
-    const bool above_first = own == 0 && above_rows;
-    if (above_first) own = preferAbove();
-    QpStatus s = dual_.solve(Cw, dlo_, dup_, c, settings_.qp, prefer_.data(), own);
-    if (s == QpStatus::NumericalFailure && own > 0 && dual_.factorize(M_, bq_, r, n, min_sigma))
-      s = dual_.solve(Cw, dlo_, dup_, c, settings_.qp);
-    if (s == QpStatus::NumericalFailure && above_rows && !above_first &&
-        dual_.factorize(M_, bq_, r, n, min_sigma)) {
-      const int cnt = preferAbove();
-      s = dual_.solve(Cw, dlo_, dup_, c, settings_.qp, prefer_.data(), cnt);
+    if (own == 0 && P > 0 && !deferred_ && above.num_active > 0) {
+      own = std::min(above.num_active, static_cast<int>(prefer_.size()));
+      std::copy_n(above.active_row.begin(), own, prefer_.begin());
     }
-    // Every order ended on nearly dependent rows: the same QP by routes that depend on no
-    // order (DualActiveSetQp::solveOrderFree), before the general path's ActiveSetQp, which
-    // can end on such rows too.
+    QpStatus s = dual_.solve(Cw, dlo_, dup_, c, settings_.qp, prefer_.data(), own);
+    if (s == QpStatus::NumericalFailure && own > 0 && deferred_ &&
+        dual_.factorize(M_, bq_, r, n, min_sigma))
+      s = dual_.solve(Cw, dlo_, dup_, c, settings_.qp);
     if ((s == QpStatus::NumericalFailure || s == QpStatus::IterationLimit) && !deferred_)
       s = dual_.solveOrderFree(Cw, dlo_, dup_, c, settings_.qp);
     if (s != QpStatus::Optimal) return false;
@@ -1215,6 +1218,11 @@ class HqpWbc {
       u_.head(k) = ys_.head(k);
       u_.segment(k, m) = dual_.x();
       lr.least_distance = true;
+      bound_count_ = std::min(dual_.numActive(), static_cast<int>(bound_row_.size()));
+      for (int a = 0; a < bound_count_; ++a) {
+        bound_row_[static_cast<std::size_t>(a)] = dual_.activeRow(a);
+        bound_upper_[static_cast<std::size_t>(a)] = dual_.activeAtUpper(a);
+      }
       return true;
     }
   }
@@ -1446,6 +1454,11 @@ class HqpWbc {
   VectorC dlo_ = VectorC::Zero(), dup_ = VectorC::Zero();  // its bounds
   int ld_rows_ = 0;  // this level's failed least-distance step's active rows, first in prefer_
   std::array<int, Nx> prefer_{};  // rows a dual solve adds first (its warm start, dualStart's)
+  // Rows at their bounds at x*_p of the level last solved (its QP's active set or the
+  // least-distance step's): the next level's QP starts from them at u = 0.
+  std::array<int, max_active> bound_row_{};
+  std::array<bool, max_active> bound_upper_{};
+  int bound_count_ = 0;
   LeastSquares ls_;
   std::array<NullSpace<capacity(max_task_rows), Nx>, sizeof...(Levels)> ns_{};  // per level: Q_p
   std::array<bool, sizeof...(Levels)> slack_{};
