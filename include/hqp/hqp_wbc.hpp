@@ -827,7 +827,7 @@ class HqpWbc {
         lr.active_upper[as] = qp.activeAtUpper(a);
         lr.multiplier[as] = qp.activeAtUpper(a) ? qp.multiplier(a) : -qp.multiplier(a);
       }
-      if (lr.status == QpStatus::Optimal && !lr.constraints_dropped) {
+      if (lr.status == QpStatus::Optimal) {  // not after dropped or relaxed own rows
         bound_count_ = std::min(lr.num_active, static_cast<int>(bound_row_.size()));
         std::copy_n(lr.active_row.begin(), bound_count_, bound_row_.begin());
         std::copy_n(lr.active_upper.begin(), bound_count_, bound_upper_.begin());
