@@ -151,12 +151,7 @@ class ActiveSetQp {
   // Sets the working set the next warm solve starts from, as if a solve at the current
   // sizes had ended on it (rows: C rows, upper: side). The solve re-checks every row.
   void setWorkingSet(int count, const int* rows, const bool* upper) {
-    nw_ = 0;
-    for (int k = 0; k < count && k < NV; ++k) {
-      ws_row_(k) = rows[k];
-      ws_upper_(k) = upper[k] ? 1 : 0;
-      ++nw_;
-    }
+    nw_ = copyRows(count, rows, upper, ws_row_, ws_upper_);
     have_ws_ = true;
   }
   // Rows believed to hold at their bounds at the x_init of the next solve (e.g. the rows active
@@ -165,15 +160,21 @@ class ActiveSetQp {
   // feasibility tolerance form its first working set (dependent ones are left out), where
   // without them it starts with none and re-adds each as a blocking row, one iteration apiece.
   void setStartRows(int count, const int* rows, const bool* upper) {
-    start_count_ = 0;
-    for (int k = 0; k < count && k < NV; ++k) {
-      start_row_(k) = rows[k];
-      start_upper_(k) = upper[k] ? 1 : 0;
-      ++start_count_;
-    }
+    start_count_ = copyRows(count, rows, upper, start_row_, start_upper_);
   }
 
  private:
+  // The first min(count, NV) rows and sides into a row list; returns how many.
+  template <class List>
+  static int copyRows(int count, const int* rows, const bool* upper, List& row, List& up) {
+    const int cnt = std::max(0, std::min(count, NV));
+    for (int k = 0; k < cnt; ++k) {
+      row(k) = rows[k];
+      up(k) = upper[k] ? 1 : 0;
+    }
+    return cnt;
+  }
+
   static constexpr double kInf = std::numeric_limits<double>::infinity();
   // Working-set changes after which the two-sided structure pays for itself (warm
   // starts and phase 1; a cold phase 2 sets it up before its first subproblem).
