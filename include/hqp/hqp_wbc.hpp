@@ -827,7 +827,8 @@ class HqpWbc {
         lr.active_upper[as] = qp.activeAtUpper(a);
         lr.multiplier[as] = qp.activeAtUpper(a) ? qp.multiplier(a) : -qp.multiplier(a);
       }
-      if (lr.status == QpStatus::Optimal) {  // not after dropped or relaxed own rows
+      // Read by the next level only; not after dropped or relaxed own rows (not Optimal).
+      if (!last && lr.status == QpStatus::Optimal) {
         bound_count_ = std::min(lr.num_active, static_cast<int>(bound_row_.size()));
         std::copy_n(lr.active_row.begin(), bound_count_, bound_row_.begin());
         std::copy_n(lr.active_upper.begin(), bound_count_, bound_upper_.begin());
@@ -934,9 +935,9 @@ class HqpWbc {
     return true;
   }
 
-  // dualLastLevel's QP over every constraint row: bounds, then up to three orders of the
-  // dual method (the first from the own rows of the warm start in prefer_). On success u_ and
-  // the active set are in lr.
+  // dualLastLevel's QP over every constraint row: bounds, then the dual method in one order
+  // (the own rows of the warm start in prefer_, or the level above's), a second on the deferred
+  // path, the order-free route on the cascade. On success u_ and the active set are in lr.
   template <int P>
   bool solveDual(int n, int col0, double min_sigma, int own, HqpLevelResult<max_active>& lr) {
     constexpr int r = LevelType<P>::task_rows;
