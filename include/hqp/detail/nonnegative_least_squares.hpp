@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -100,19 +101,20 @@ class NonNegativeLeastSquares {
         if (hit < 0) break;
         if (iterations_ >= max_iterations) return false;
         ++iterations_;
-        int kept = 0;
+        int kept = 0, first_freed = np_;
         for (int k = 0; k < np_; ++k) {
           const int j = P_(k);
           mu_(j) += alpha * (z_(k) - mu_(j));
           if (k == hit || !(mu_(j) > 0.0)) {
             mu_(j) = 0.0;
             passive_(j) = 0;
+            first_freed = std::min(first_freed, k);
           } else {
             P_(kept++) = j;
           }
         }
         np_ = kept;
-        qr_cols_ = 0;
+        qr_cols_ = std::min(qr_cols_, first_freed);  // the columns before it did not move
         ++version;
         if (!leastSquares()) return false;
       }
