@@ -218,10 +218,11 @@ class DualActiveSetQp {
     if (in != QpStatus::Optimal) return in;
     for (int k = 0; k < prefer_count; ++k)
       if (prefer[k] >= 0 && prefer[k] < m) prefer_(prefer[k]) = 1;
-    if (start_count > 0 && xs_.size() == n && startPointOptimal(C, m, start_count) &&
-        verified(C, lower, upper, m, settings) == QpStatus::Optimal)
-      return QpStatus::Optimal;
-    if (q_ > 0) {  // not the optimum: the method from x0 (the factors were not touched)
+    if (start_count > 0 && xs_.size() == n) {
+      if (startPointOptimal(C, m, start_count) &&
+          verified(C, lower, upper, m, settings) == QpStatus::Optimal)
+        return QpStatus::Optimal;
+      // Not the optimum: the method from x0 (the factors were not touched).
       for (int k = 0; k < q_; ++k) active_(row_(k)) = 0;
       q_ = 0;
       x_ = x0_;
