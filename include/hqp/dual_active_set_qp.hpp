@@ -189,44 +189,15 @@ class DualActiveSetQp {
                        prefer_count);
   }
 
-  // A start point for the next solve() only: x (n entries) and the rows (with sides) at their
-  // bounds there, e.g. the point a cascade's level starts from and the rows the level above
-  // ended on. solve() first asks whether x is the optimum: every row holds there and the
-  // objective's gradient lies in the cone of those rows' normals (a non-negative least-squares
-  // fit, in the whitened coordinates w = R (x − x0) where it is w itself). If the final check
-  // (verified) then passes, x is returned with the fit's rows and multipliers and no iteration;
-  // otherwise the method runs from x0 as without it. Rows out of range are ignored; at most
-  // MaxN rows are kept.
-  template <class Vec>
-  void setStartPoint(const Vec& x, int count, const int* rows, const bool* upper) noexcept {
-    start_count_ = std::max(0, std::min(count, MaxN));
-    xs_ = x;
-    for (int k = 0; k < start_count_; ++k) {
-      start_row_(k) = rows[k];
-      start_upper_(k) = upper[k] ? 1 : 0;
-    }
-  }
-
  private:
   QpStatus solveMapped(const ColumnsMap& C, const VectorMap& lower, const VectorMap& upper,
                        int m, const QpSettings& settings, const int* prefer = nullptr,
                        int prefer_count = 0) noexcept {
     const int n = n_;
-    const int start_count = start_count_;
-    start_count_ = 0;
     const QpStatus in = start(C, lower, upper, m, settings);
     if (in != QpStatus::Optimal) return in;
     for (int k = 0; k < prefer_count; ++k)
       if (prefer[k] >= 0 && prefer[k] < m) prefer_(prefer[k]) = 1;
-    if (start_count > 0 && xs_.size() == n) {
-      if (startPointOptimal(C, m, start_count) &&
-          verified(C, lower, upper, m, settings) == QpStatus::Optimal)
-        return QpStatus::Optimal;
-      // Not the optimum: the method from x0 (the factors were not touched).
-      for (int k = 0; k < q_; ++k) active_(row_(k)) = 0;
-      q_ = 0;
-      x_ = x0_;
-    }
     cx_.head(m).noalias() = C.topLeftCorner(m, n) * x_;
     for (;;) {
       // Step 1: the most violated row side (violation scaled to a unit-norm row).
@@ -471,50 +442,6 @@ class DualActiveSetQp {
     return verified(C, lower, upper, m, settings);
   }
 
-  // setStartPoint(): the gradient of ½‖w‖² at the point, w = R (x − x0), fitted by the start
-  // rows' normals in w (ĝ = R⁻ᵀ n, n = ±cᵀ as each side reads n x ≥ β) with non-negative
-  // coefficients. A fit to rounding makes x, those rows and multipliers the KKT point that
-  // verified() then checks (its rows at their bounds, every row held, stationarity). True with
-  // x_ and the active set set; false with nothing set.
-  template <class MatC>
-  bool startPointOptimal(const MatC& C, int m, int count) {
-    const int n = n_;
-    auto& E = ldp_.E();
-    const auto Rinv = Jr_.topLeftCorner(n, n);  // upper triangular, zero below (factorize)
-    int cols = 0;
-    for (int k = 0; k < count; ++k) {
-      const int j = start_row_(k);
-      if (j < 0 || j >= m) continue;
-      const double sgn = start_upper_(k) ? -1.0 : 1.0;
-      np_.head(n).noalias() = Rinv.transpose() * C.row(j).head(n).transpose();
-      const double gn = np_.head(n).norm();
-      if (!(gn > 0.0)) continue;
-      E.col(cols).head(n) = (sgn / gn) * np_.head(n);
-      ldp_scale_(cols) = gn;
-      ldp_row_(cols) = start_upper_(k) ? -1 - j : j;
-      ++cols;
-    }
-    const auto R = F_.topLeftCorner(n, n).template triangularView<Eigen::Upper>();
-    z_.head(n) = xs_ - x0_;
-    ldp_.f().head(n).noalias() = R * z_.head(n);
-    const double fn = ldp_.f().head(n).norm();
-    if (cols == 0 || !std::isfinite(fn)) return false;
-    if (!ldp_.solve(n, cols, decltype(ldp_)::iterationCap(0, cols))) return false;
-    if (!(ldp_.residual().head(n).norm() <= 1e-6 * fn)) return false;
-    x_ = xs_;
-    for (int k = 0; k < ldp_.numPassive() && q_ < MaxN; ++k) {
-      const int col = ldp_.passive(k), code = ldp_row_(col);
-      const int j = code < 0 ? -1 - code : code;
-      if (active_(j)) continue;
-      row_(q_) = j;
-      upper_(q_) = code < 0 ? 1 : 0;
-      u_(q_) = ldp_.mu()(col) / ldp_scale_(col);
-      active_(j) = 1;
-      ++q_;
-    }
-    return true;
-  }
-
   // Rotation (a, b) → (ρ, 0) applied to columns i, i + 1 of J: J ← J Gᵀ.
   void rotateJ(int i, double c, double s) {
     for (int l = 0; l < n_; ++l) {
@@ -722,9 +649,6 @@ class DualActiveSetQp {
   Eigen::Matrix<int, MaxN, 1> row_, upper_;
   Eigen::Matrix<double, MaxIneq, 1> cx_, rinv_;
   Eigen::Matrix<int, MaxIneq, 1> active_, prefer_;
-  Eigen::Matrix<int, MaxN, 1> start_row_, start_upper_;  // setStartPoint()
-  int start_count_ = 0;
-  VectorX xs_;
   VectorX x0_, x_;
   detail::NonNegativeLeastSquares<MaxN + 1, 2 * MaxIneq> ldp_;  // leastDistance()
   Eigen::Matrix<double, 2 * MaxIneq, 1> ldp_scale_;  // its columns: the row's ‖R⁻ᵀcᵀ‖

@@ -695,8 +695,7 @@ class HqpWbc {
         std::sqrt((ha_.template segment<r>(t0).array() * w_.template segment<r>(t0).array())
                       .maxCoeff());
     if constexpr (P + 1 == num_levels && c > 0 && !std::is_same_v<DualQp, detail::NoQp>) {
-      if (settings_.dual_last_level && r >= n && dualLastLevel<P>(n, col0, scale, bound_above, lr))
-        return;
+      if (settings_.dual_last_level && r >= n && dualLastLevel<P>(n, col0, scale, lr)) return;
       if (aborted_) return;  // the deferred path's QP failed: no second try here
     }
     if constexpr (last) {
@@ -893,8 +892,7 @@ class HqpWbc {
   // pass, docs/hqp.md) or if the dual method ends without an optimum (e.g. infeasible own
   // rows: the general path handles them).
   template <int P>
-  bool dualLastLevel(int n, int col0, double scale, int bound_above,
-                     HqpLevelResult<max_active>& lr) {
+  bool dualLastLevel(int n, int col0, double scale, HqpLevelResult<max_active>& lr) {
     constexpr int r = LevelType<P>::task_rows;
     constexpr int t0 = task_offset[P];
     constexpr int c = constraint_offset[P + 1];
@@ -916,7 +914,7 @@ class HqpWbc {
       u_ = dual_.unconstrainedMinimizer();
       lr.iterations = 0;
       lr.num_active = 0;
-    } else if (!solveDual<P>(n, col0, min_sigma, own, bound_above, lr)) {
+    } else if (!solveDual<P>(n, col0, min_sigma, own, lr)) {
       return false;
     }
     aborted_ = false;
@@ -941,8 +939,7 @@ class HqpWbc {
   // (the own rows of the warm start in prefer_, or the level above's), a second on the deferred
   // path, the order-free route on the cascade. On success u_ and the active set are in lr.
   template <int P>
-  bool solveDual(int n, int col0, double min_sigma, int own, int bound_above,
-                 HqpLevelResult<max_active>& lr) {
+  bool solveDual(int n, int col0, double min_sigma, int own, HqpLevelResult<max_active>& lr) {
     constexpr int r = LevelType<P>::task_rows;
     constexpr int c0 = constraint_offset[P];
     constexpr int c = constraint_offset[P + 1];
@@ -971,12 +968,6 @@ class HqpWbc {
     if (own == 0 && P > 0 && !deferred_ && above.num_active > 0) {
       own = std::min(above.num_active, static_cast<int>(prefer_.size()));
       std::copy_n(above.active_row.begin(), own, prefer_.begin());
-    }
-    // The rows the level above ended on sit at their bounds at u = 0 (x*_{p−1}), and 91 % of
-    // the last level's active rows on the stress family are among them: is u = 0 the optimum?
-    if (!deferred_ && bound_above > 0) {
-      u_.setZero(n);
-      dual_.setStartPoint(u_, bound_above, bound_row_.data(), bound_upper_.data());
     }
     QpStatus s = dual_.solve(Cw, dlo_, dup_, c, settings_.qp, prefer_.data(), own);
     if (s == QpStatus::NumericalFailure && own > 0 && deferred_ &&

@@ -250,9 +250,8 @@ TEST(Recording, CertificateOnIllConditionedLevelsPassesOnlyTheOptimum) {
 
 // Stress instances 201, 221 and 265 of the corpus: level 2's contact target is out of reach, so
 // its least-distance step fails and the dual start (from that step's active rows) sets the QP's
-// working set; the last level's optimum is the point level 3 ended on (its start point check).
-// Every level must end at the optimum that the primal route alone reaches (no least-distance
-// step, no dual start, no dual last level, no deferred attempt), level by level.
+// working set. Every level must end at the optimum that the primal route alone reaches (no
+// least-distance step, no dual start, no dual last level, no deferred attempt), level by level.
 TEST(Recording, OutOfReachLevelReachesTheOptimumOfThePrimalRoute) {
   hqp::ProblemFileInfo info;
   const auto v = hqp::readProblemFile<Replay>(HQP_OUT_OF_REACH_FILE, &info);
@@ -276,12 +275,6 @@ TEST(Recording, OutOfReachLevelReachesTheOptimumOfThePrimalRoute) {
       EXPECT_FALSE(l2.least_distance) << k;  // the step was tried and failed ...
       EXPECT_TRUE(l2.dual_start) << k;       // ... and the dual start ran
       EXPECT_FALSE(ref->result().levels[1].dual_start) << k;
-      // Level 3 ends at a degenerate vertex (12 rows at their bounds in 12 variables), and the
-      // last level's optimum is that point: its start point check returns it with no iteration.
-      const auto& l4 = r.levels[Replay::num_levels - 1];
-      EXPECT_TRUE(l4.dual) << k;
-      EXPECT_EQ(l4.iterations, 0) << k << " warm " << warm;
-      EXPECT_GT(ref->result().levels[Replay::num_levels - 1].iterations, 0) << k;
       for (int p = 0; p < Replay::num_levels; ++p) {
         ASSERT_EQ(r.levels[p].status, hqp::QpStatus::Optimal) << k << " level " << p;
         ASSERT_EQ(ref->result().levels[p].status, hqp::QpStatus::Optimal) << k << " level " << p;

@@ -9,12 +9,11 @@
 // coefficient in the new least-squares solution is positive (Lawson and Hanson's guard against
 // rounding); otherwise it is set aside until the passive set changes. So the passive columns
 // stay numerically independent and the least-squares solves on them meaningful.
-// Each least-squares solve is a Householder QR of the passive columns (at most `rows` of them),
-// built column by column, whose prefix is kept while columns are only appended.
+// Each least-squares solve is a fresh Householder QR of the passive columns (at most `rows` of
+// them; qp_min_norm_ls.hpp's kernel): this runs only on the rare fallback, so it is kept plain.
 
 #include <Eigen/Core>
 
-#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -50,8 +49,6 @@ class NonNegativeLeastSquares {
     rows_ = rows;
     np_ = 0;
     iterations_ = 0;
-    qr_cols_ = 0;
-    w_cols_ = 0;
     if (rows <= 0 || rows > MaxRows || cols < 0 || cols > MaxCols) return false;
     int version = 0;  // passive-set changes; a set-aside column waits for the next one
     for (int j = 0; j < cols; ++j) {
@@ -82,7 +79,6 @@ class NonNegativeLeastSquares {
       if (!leastSquares() || !(std::abs(W_(np_ - 1, np_ - 1)) > dependent * norm_(t)) ||
           !(z_(np_ - 1) > 0.0)) {
         --np_;
-        qr_cols_ = np_;  // the prefix's factors hold; w_ had t's reflector applied
         passive_(t) = 0;
         aside_(t) = version;
         continue;
@@ -101,20 +97,18 @@ class NonNegativeLeastSquares {
         if (hit < 0) break;
         if (iterations_ >= max_iterations) return false;
         ++iterations_;
-        int kept = 0, first_freed = np_;
+        int kept = 0;
         for (int k = 0; k < np_; ++k) {
           const int j = P_(k);
           mu_(j) += alpha * (z_(k) - mu_(j));
           if (k == hit || !(mu_(j) > 0.0)) {
             mu_(j) = 0.0;
             passive_(j) = 0;
-            first_freed = std::min(first_freed, k);
           } else {
             P_(kept++) = j;
           }
         }
         np_ = kept;
-        qr_cols_ = std::min(qr_cols_, first_freed);  // the columns before it did not move
         ++version;
         if (!leastSquares()) return false;
       }
@@ -133,31 +127,14 @@ class NonNegativeLeastSquares {
 
  private:
   // z = argmin ‖E_P z − f‖ over the passive columns in the order of P_ (Householder QR in W_,
-  // R on and above the diagonal, built column by column); false if some R_kk is 0 or a number
-  // is non-finite. The factors of a prefix of P_ that did not change (qr_cols_: a column was
-  // appended, the common step) are kept, so an append costs O(rows · k), not a new QR.
+  // R on and above the diagonal); false if some R_kk is 0 or a number is non-finite.
   bool leastSquares() {
     const int m = rows_, k = np_;
     if (k > m) return false;
-    const int c0 = qr_cols_ < k ? qr_cols_ : 0;
-    if (c0 == 0 || w_cols_ != c0) {  // w_ = H_{c0−1} … H_0 f
-      w_.head(m) = f_.head(m);
-      for (int i = 0; i < c0; ++i) qpApplyReflector(W_, i, m, tau_(i), w_);
-    }
-    for (int c = c0; c < k; ++c) {
-      auto col = W_.col(c);
-      col.head(m) = E_.col(P_(c)).head(m);
-      for (int i = 0; i < c; ++i) qpApplyReflector(W_, i, m, tau_(i), col);
-      double beta = 0.0;
-      col.segment(c, m - c).makeHouseholderInPlace(tau_(c), beta);
-      W_(c, c) = beta;
-      if (!(beta != 0.0)) {
-        qr_cols_ = w_cols_ = c;
-        return false;
-      }
-      qpApplyReflector(W_, c, m, tau_(c), w_);
-    }
-    qr_cols_ = w_cols_ = k;
+    for (int c = 0; c < k; ++c) W_.col(c).head(m) = E_.col(P_(c)).head(m);
+    w_.head(m) = f_.head(m);
+    if (!qpHouseholderQr(W_, m, k, 0.0, tau_, tau_)) return false;
+    for (int i = 0; i < k; ++i) qpApplyReflector(W_, i, m, tau_(i), w_);
     for (int i = k - 1; i >= 0; --i) {
       double s = w_(i);
       for (int c = i + 1; c < k; ++c) s -= W_(i, c) * z_(c);
@@ -168,7 +145,6 @@ class NonNegativeLeastSquares {
 
   static constexpr int MaxP = MaxRows < MaxCols ? MaxRows : MaxCols;
   int rows_ = 0, np_ = 0, iterations_ = 0;
-  int qr_cols_ = 0, w_cols_ = 0;  // leastSquares(): columns factored, reflectors applied to w_
   MatrixE E_;
   VectorF f_, res_, w_;
   VectorMu mu_, norm_;
