@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -24,6 +25,51 @@
 #include "hqp/qp_status.hpp"
 
 namespace hqp {
+
+// A checked Farkas certificate of rows lower ≤ C x ≤ upper having no common point: rows j_k,
+// each written n_k x ≥ β_k (n = c_j, β = lower_j at the lower side; n = −c_j, β = −upper_j at
+// the upper side), weights y_k ≥ 0 with ρ = Σ y_k n_k ≈ 0 and Σ y_k β_k > 0. DualActiveSetQp
+// records one where it returns Infeasible; proves() checks it against any rows with the same
+// indexing, e.g. the same rows restricted to a subspace (C Z): the rows then conflict there
+// too. Capacity: MaxRows entries.
+template <int MaxRows>
+struct FarkasCertificate {
+  int count = 0;
+  std::array<int, MaxRows> row{};
+  std::array<bool, MaxRows> at_upper{};
+  std::array<double, MaxRows> y{};
+
+  // True if the rows C (n columns), lower, upper contradict by more than tol: with τ_k =
+  // tol (‖n_k‖ + |β_k|), any x that meets every row to τ satisfies ρᵀx − Σ y β ≥ −Σ y τ, so
+  // none exists with ‖x‖ ≤ X = tol / ε · (1 + max |β̂|) (beyond X no row value can be
+  // computed to the tolerance in double precision) if Σ y β > Σ y τ + ‖ρ‖ X; ρ must be rounding
+  // (‖ρ‖ ≤ 1e-12 Σ y ‖n‖), else the rows are only nearly dependent and a feasible point may lie
+  // far out. rinv(j): 1 / ‖c_j‖ (1 for a zero row); z: scratch of n entries. Rows beyond m or
+  // an infinite bound: false.
+  template <class MatC, class VecL, class VecU, class RowInv, class Vec>
+  bool proves(const MatC& C, const VecL& lower, const VecU& upper, int m, int n, double tol,
+              const RowInv& rinv, Vec& z) const {
+    if (count == 0) return false;
+    z.head(n).setZero();
+    double gap = 0.0, slack = 0.0, ysum = 0.0, bmax = 0.0;
+    for (int k = 0; k < count; ++k) {
+      const std::size_t ks = static_cast<std::size_t>(k);
+      const int j = row[ks];
+      if (j < 0 || j >= m) return false;
+      const double b = at_upper[ks] ? -upper(j) : lower(j);
+      if (!(std::abs(b) < std::numeric_limits<double>::infinity())) return false;
+      const double yk = y[ks], ri = rinv(j);
+      z.head(n) += (at_upper[ks] ? -yk : yk) * C.row(j).head(n).transpose();
+      gap += yk * b;
+      slack += yk * tol * (1.0 / ri + std::abs(b));
+      ysum += yk / ri;
+      bmax = std::max(bmax, std::abs(b) * ri);
+    }
+    const double rho = z.head(n).norm();
+    const double X = tol / std::numeric_limits<double>::epsilon() * (1.0 + bmax);
+    return rho <= 1e-12 * ysum && gap > slack + rho * X;
+  }
+};
 
 template <int MaxN, int MaxRows, int MaxIneq>
 class DualActiveSetQp {
@@ -249,7 +295,7 @@ class DualActiveSetQp {
           // n_p = Σ r_k n_k with every r_k ≤ 0. Infeasible only if the bounds contradict by
           // more than the tolerance (a checked Farkas certificate); otherwise the violation
           // is rounding of a (nearly) duplicate row: the row is held by the active rows.
-          if (certifiedInfeasible(C, lower, upper, p, up, settings)) return QpStatus::Infeasible;
+          if (certifiedInfeasible(C, lower, upper, m, p, up, settings)) return QpStatus::Infeasible;
           for (int k = 0; k < q_; ++k) u_(k) += uplus * r_(k);  // n_p's multiplier moves to them
           if (uplus > 0.0 && (u_.head(q_).array() < 0.0).any()) return QpStatus::NumericalFailure;
           active_(p) = 2;
@@ -328,6 +374,10 @@ class DualActiveSetQp {
 
   const VectorX& x() const { return x_; }
   const VectorX& unconstrainedMinimizer() const { return x0_; }
+  using Certificate = FarkasCertificate<MaxN + 1>;
+  // After solve() returned Infeasible on a dependent violated row: the checked certificate
+  // (the violated row first, then the active rows); count 0 after any other outcome.
+  const Certificate& certificate() const { return cert_; }
   // Tolerance of the stationarity check before Optimal (relative to the terms' magnitude).
   static constexpr double kStationarityTol = 1e-8;
   // Relative duality gap accepted where stationarity holds only to the multipliers' size.
@@ -353,6 +403,7 @@ class DualActiveSetQp {
     q_ = 0;
     held_ = 0;
     iterations_ = 0;
+    cert_.count = 0;
     if (!factorized_ || m < 0 || m > MaxIneq) {
       x_.setZero(n > 0 ? n : 0);
       return QpStatus::InvalidInput;
@@ -499,36 +550,25 @@ class DualActiveSetQp {
   }
 
   // Farkas check for a violated row p (side up) dependent on the active rows, n_p = Σ r_k n_k
-  // with r = r_ ≤ 0, each row written n x ≥ β (n = c at lower, −c at upper). With y = (1, −r)
-  // ≥ 0, any x meeting every row to its tolerance τ = feasibility_tol (‖n‖ + |β|) satisfies
-  // Σ y_k (n_k x − β_k) ≥ −Σ y_k τ_k, i.e. ρᵀx − gap ≥ −Σ y τ with ρ = Σ y n (rounding) and
-  // gap = Σ y β. No x with ‖x‖ ≤ X = feasibility_tol / ε · (1 + max |β̂|) exists if gap exceeds
-  // both (beyond X no row value can be computed to the tolerance in double precision); ρ
-  // must be rounding (‖ρ‖ ≤ 1e-12 Σ y ‖n‖), else the rows are only nearly dependent and a
-  // feasible point may lie far out.
+  // with r = r_ ≤ 0: the certificate y = (1, −r) on (p, the active rows), checked by
+  // FarkasCertificate::proves and kept as certificate() if it holds.
   template <class MatC, class VecL, class VecU>
-  bool certifiedInfeasible(const MatC& C, const VecL& lower, const VecU& upper, int p, bool up,
-                           const QpSettings& settings) {
-    const int n = n_;
-    const double tol = settings.feasibility_tol;
-    auto beta = [&](int j, bool upper_side) { return upper_side ? -upper(j) : lower(j); };
-    z_.head(n) = (up ? -1.0 : 1.0) * C.row(p).head(n).transpose();  // ρ
-    double gap = beta(p, up);
-    double slack = tol * (1.0 / rinv_(p) + std::abs(gap)), ysum = 1.0 / rinv_(p);
-    double bmax = std::abs(gap) * rinv_(p);
+  bool certifiedInfeasible(const MatC& C, const VecL& lower, const VecU& upper, int m, int p,
+                           bool up, const QpSettings& settings) {
+    cert_.row[0] = p;
+    cert_.at_upper[0] = up;
+    cert_.y[0] = 1.0;
     for (int k = 0; k < q_; ++k) {
-      const int j = row_(k);
-      const bool uk = upper_(k) != 0;
-      const double y = -r_(k), b = beta(j, uk);
-      z_.head(n) += (uk ? -y : y) * C.row(j).head(n).transpose();
-      gap += y * b;
-      slack += y * tol * (1.0 / rinv_(j) + std::abs(b));
-      ysum += y / rinv_(j);
-      bmax = std::max(bmax, std::abs(b) * rinv_(j));
+      const std::size_t ks = static_cast<std::size_t>(k + 1);
+      cert_.row[ks] = row_(k);
+      cert_.at_upper[ks] = upper_(k) != 0;
+      cert_.y[ks] = -r_(k);
     }
-    const double rho = z_.head(n).norm();
-    const double X = tol / std::numeric_limits<double>::epsilon() * (1.0 + bmax);
-    return rho <= 1e-12 * ysum && gap > slack + rho * X;
+    cert_.count = q_ + 1;
+    const bool holds = cert_.proves(C, lower, upper, m, n_, settings.feasibility_tol,
+                                    [this](int j) { return rinv_(j); }, z_);
+    if (!holds) cert_.count = 0;
+    return holds;
   }
 
   // The final check's rows, with cx_ = C x: every row (both sides, active rows included)
@@ -641,6 +681,7 @@ class DualActiveSetQp {
 
   bool factorized_ = false;
   int n_ = 0, m_ = 0, q_ = 0, held_ = 0, iterations_ = 0;
+  Certificate cert_;  // solve()'s Farkas certificate where it ended Infeasible on one
   Eigen::Matrix<double, MaxRows, MaxN> F_;   // QR of A (R on and above the diagonal)
   Eigen::Matrix<double, MaxRows, 1> c_;  // Q_Aᵀ b
   Eigen::Matrix<double, MaxN, MaxN> J_, Ra_;

@@ -5,6 +5,7 @@
 #define EIGEN_RUNTIME_NO_MALLOC
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <random>
 
 #include <Eigen/QR>
@@ -56,6 +57,40 @@ double kktError(const Qp& qp, const hqp::testing::RandomQp& p) {
   return err;
 }
 
+// A Farkas certificate checked here from the problem's data: weights y ≥ 0 on rows written
+// n x ≥ β (n = c, β = lower at the lower side; n = −c, β = −upper at the upper side) with
+// Σ y n = 0 to rounding and Σ y β > 0, so no x meets every row.
+template <class Certificate>
+void expectCertifies(const Certificate& cert, const hqp::testing::RandomQp& p, int trial) {
+  ASSERT_GT(cert.count, 0) << "trial " << trial;
+  Eigen::VectorXd rho = Eigen::VectorXd::Zero(p.C.cols());
+  double gap = 0.0, ysum = 0.0;
+  for (int k = 0; k < cert.count; ++k) {
+    const auto ks = static_cast<std::size_t>(k);
+    const int j = cert.row[ks];
+    ASSERT_GE(j, 0);
+    ASSERT_LT(j, p.C.rows());
+    const double y = cert.y[ks];
+    EXPECT_GE(y, 0.0) << "trial " << trial;
+    const double sign = cert.at_upper[ks] ? -1.0 : 1.0;
+    const double beta = cert.at_upper[ks] ? -p.upper(j) : p.lower(j);
+    ASSERT_TRUE(std::isfinite(beta)) << "trial " << trial;
+    rho += y * sign * p.C.row(j).transpose();
+    gap += y * beta;
+    ysum += y * p.C.row(j).norm();
+  }
+  EXPECT_LE(rho.norm(), 1e-10 * ysum) << "trial " << trial;
+  EXPECT_GT(gap, 0.0) << "trial " << trial;
+  // The same rows with bounds around C·0 have a common point (x = 0): not a conflict there.
+  const Eigen::VectorXd lo = Eigen::VectorXd::Constant(p.C.rows(), -1.0);
+  const Eigen::VectorXd up = Eigen::VectorXd::Constant(p.C.rows(), 1.0);
+  Eigen::VectorXd z(p.C.cols());
+  const auto rinv = [&](int j) { return 1.0 / std::max(p.C.row(j).norm(), 1e-300); };
+  EXPECT_FALSE(cert.proves(p.C, lo, up, static_cast<int>(p.C.rows()), static_cast<int>(p.C.cols()),
+                           1e-9, rinv, z))
+      << "trial " << trial;
+}
+
 // 1500 small problems (n ≤ 6, ≤ 10 rows, 10 % built infeasible) solved by `route` against the
 // enumeration reference: its optimum and the KKT conditions on the rows reported; an
 // infeasible problem ends Infeasible, or, for a route that does not certify infeasibility, at
@@ -65,7 +100,7 @@ void matchesBruteForce(unsigned seed, Route route, bool certifies_infeasibility)
   std::mt19937 rng(seed);
   std::uniform_int_distribution<int> Un(1, 6), Uextra(0, 4), Umi(0, 10), U100(0, 99);
   SmallQp qp;
-  int feasible = 0, infeasible = 0, active = 0;
+  int feasible = 0, infeasible = 0, active = 0, certified = 0;
   for (int trial = 0; trial < 1500; ++trial) {
     const int n = Un(rng);
     const int m = n + Uextra(rng);
@@ -78,10 +113,16 @@ void matchesBruteForce(unsigned seed, Route route, bool certifies_infeasibility)
     if (!ref.feasible) {
       if (certifies_infeasibility) EXPECT_EQ(s, hqp::QpStatus::Infeasible) << "trial " << trial;
       else EXPECT_NE(s, hqp::QpStatus::Optimal) << "trial " << trial;
+      // Infeasible on a dependent violated row: its certificate (an empty interval has none).
+      if (certifies_infeasibility && qp.certificate().count > 0) {
+        expectCertifies(qp.certificate(), p, trial);
+        ++certified;
+      }
       ++infeasible;
       continue;
     }
     ASSERT_EQ(s, hqp::QpStatus::Optimal) << "trial " << trial;
+    EXPECT_EQ(qp.certificate().count, 0) << "trial " << trial;
     ++feasible;
     active += qp.numActive() > 0;
     const double xs = 1.0 + ref.x.cwiseAbs().maxCoeff();
@@ -92,6 +133,8 @@ void matchesBruteForce(unsigned seed, Route route, bool certifies_infeasibility)
   EXPECT_GT(feasible, 1000);
   EXPECT_GT(infeasible, 50);
   EXPECT_GT(active, 500);
+  if (certifies_infeasibility) EXPECT_GT(certified, 30);
+  std::printf("infeasible %d, with a certificate %d\n", infeasible, certified);
 }
 
 TEST(QpDual, SmallStrictlyConvexProblemsMatchBruteForce) {
