@@ -937,8 +937,9 @@ class HqpWbc {
   }
 
   // dualLastLevel's QP over every constraint row: bounds, then the dual method in one order
-  // (the own rows of the warm start in prefer_, and on the cascade the level above's), a second on the deferred
-  // path, the order-free route on the cascade. On success u_ and the active set are in lr.
+  // (the own rows of the warm start in prefer_, and on the cascade the level above's), a second
+  // on the deferred path, the order-free route on the cascade. On success u_ and the active set
+  // are in lr.
   template <int P>
   bool solveDual(int n, int col0, double min_sigma, int own, HqpLevelResult<max_active>& lr) {
     constexpr int r = LevelType<P>::task_rows;
