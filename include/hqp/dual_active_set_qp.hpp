@@ -374,6 +374,13 @@ class DualActiveSetQp {
 
   const VectorX& x() const { return x_; }
   const VectorX& unconstrainedMinimizer() const { return x0_; }
+  // 1 / ‖row‖ (1 for a zero row): the scale of every violation and tolerance the method applies
+  // to a row; a certificate checked elsewhere on the same rows (proves' rinv) must use it too.
+  template <class Row>
+  static double inverseRowNorm(const Row& row) {
+    const double nrm = row.norm();
+    return nrm > 0.0 ? 1.0 / nrm : 1.0;
+  }
   using Certificate = FarkasCertificate<MaxN + 1>;
   // After solve() returned Infeasible on a dependent violated row: the checked certificate
   // (the violated row first, then the active rows); count 0 after any other outcome.
@@ -419,8 +426,7 @@ class DualActiveSetQp {
         return QpStatus::InvalidInput;
       }
     for (int j = 0; j < m; ++j) {
-      const double nrm = C.row(j).head(n).norm();
-      rinv_(j) = nrm > 0.0 ? 1.0 / nrm : 1.0;
+      rinv_(j) = inverseRowNorm(C.row(j).head(n));
       active_(j) = 0;
       prefer_(j) = 0;
       if ((lower(j) - upper(j)) * rinv_(j) > settings.feasibility_tol) return QpStatus::Infeasible;

@@ -1248,10 +1248,7 @@ class HqpWbc {
   template <class MatV>
   bool conflictShown(const MatV& Cv, int c, int m) {
     if (conflict_.count == 0) return false;
-    const auto rinv = [&](int j) {
-      const double nrm = Cv.row(j).norm();
-      return nrm > 0.0 ? 1.0 / nrm : 1.0;
-    };
+    const auto rinv = [&](int j) { return DualQp::inverseRowNorm(Cv.row(j)); };
     return conflict_.proves(Cv, dlo_, dup_, c, m, settings_.qp.feasibility_tol, rinv, conflict_z_);
   }
 
