@@ -937,7 +937,7 @@ class HqpWbc {
   }
 
   // dualLastLevel's QP over every constraint row: bounds, then the dual method in one order
-  // (the own rows of the warm start in prefer_, and on the cascade the level above's), a second
+  // (the warm start's rows in prefer_, or on the cascade the level above's), a second
   // on the deferred path, the order-free route on the cascade. On success u_ and the active set
   // are in lr.
   template <int P>
@@ -957,23 +957,24 @@ class HqpWbc {
       if (!dualRowBounds(i, own_begin, 0.0, cnorm_(i), i >= own_begin)) return false;
     }
     // Any order of the violated rows is valid for the dual method, and an order that ends on
-    // nearly dependent rows (NumericalFailure) may be avoided by another. The first order is the
-    // level's working set (the previous tick's active set, or a recorded one) and, on the
-    // cascade, the level above's active set (its rows hold at x*_{p−1}, and most of them stay
-    // active; the method takes the most violated of these rows first, so their order does not
-    // matter). A working set from a deferred solve, whose higher levels met no row, misses them:
-    // with them the stress family's last level takes 14.0 in place of 14.9 iterations per
-    // instance (233: 39 → 25), and 15 in place of 17 where the working set is empty.
+    // nearly dependent rows (NumericalFailure) may be avoided by another. The first order is, on
+    // the cascade, the level above's active set where it has one (its rows hold at x*_{p−1},
+    // and most of them stay active; the method takes the most violated of these rows first, so
+    // their order does not matter), else the level's working set (the previous tick's active
+    // set, or a recorded one). The working set is not added to the level above's rows: where it
+    // is the optimum's own nearly dependent vertex (a controller's next tick on an unchanged
+    // problem) the union ended NumericalFailure on 6 stress instances (203, 242: ~150 µs through
+    // the order-free route), the level above's rows alone on 3 (docs/benchmarks.md, "The steady
+    // state"); on the recorded stress family the two take 14.00 and 13.93 iterations.
     // On the deferred path the method's own order (most violated first) is the second; on the
     // cascade a failed first order goes to routes that depend on no order
     // (DualActiveSetQp::solveOrderFree), before the general path's ActiveSetQp, which can end
     // on such rows too: there another order met the same rows on every stress instance seen
     // (docs/benchmarks.md, "The stress tail by phase").
     const auto& above = result_.levels[P > 0 ? P - 1 : 0];
-    if (P > 0 && !deferred_ && above.num_active > 0) {  // a row twice is harmless
-      const int add = std::min(above.num_active, static_cast<int>(prefer_.size()) - own);
-      std::copy_n(above.active_row.begin(), add, prefer_.begin() + own);
-      own += add;
+    if (P > 0 && !deferred_ && above.num_active > 0) {
+      own = std::min(above.num_active, static_cast<int>(prefer_.size()));
+      std::copy_n(above.active_row.begin(), own, prefer_.begin());
     }
     QpStatus s = dual_.solve(Cw, dlo_, dup_, c, settings_.qp, prefer_.data(), own);
     if (s == QpStatus::NumericalFailure && own > 0 && deferred_ &&
@@ -1480,8 +1481,8 @@ class HqpWbc {
   FarkasCertificate<Nx + 1> conflict_;  // the deferred attempt's (conflictShown)
   Eigen::Matrix<double, Nx, 1> conflict_z_;  // its scratch
   int ld_rows_ = 0;  // this level's failed least-distance step's active rows, first in prefer_
-  // Rows a dual solve adds first: its warm start (at most Nx) and the level above's active rows.
-  std::array<int, Nx + max_active> prefer_{};
+  // Rows a dual solve adds first: its warm start (at most Nx) or the level above's active rows.
+  std::array<int, std::max(Nx, max_active)> prefer_{};
   // Rows at their bounds at x*_p of the level last solved (its QP's active set or the
   // least-distance step's): the next level's QP starts from them at u = 0.
   std::array<int, max_active> bound_row_{};
