@@ -11,10 +11,14 @@
 #       (default 5) on one pinned core; prints per family the medians over the rounds and
 #       old/new, and the peers of each binary (BM_PeerWarm, and the corpus peer) as a check
 #       that the machine did not drift between them. OLD_CORPUS_DIR=DIR gives the old binary
-#       another copy of the corpus (below).
-#   bash scripts/corpus.sh v2 DIR    # the corpus as format version 2 into DIR, for a bench_hqp
-#       from before version 3 (e.g. 3c579bd, before the deferred path): the same instances
-#       without the header's defer_constraints field (docs/recording.md)
+#       another copy of the corpus (below), NEW_CORPUS_DIR=DIR the new one (e.g. steady).
+#   bash scripts/corpus.sh steady DIR   # the families into DIR with each instance warm-started
+#       from the working sets its own solve ends with (a controller's next tick on an unchanged
+#       problem; docs/benchmarks.md, "The steady state")
+#   bash scripts/corpus.sh v2 DIR [SRC]  # the corpus (or the files in SRC) as format version 2
+#       into DIR, for a bench_hqp from before version 3 (e.g. 3c579bd, before the deferred
+#       path): the same instances without the header's defer_constraints field
+#       (docs/recording.md)
 # make: one sim_demo recording per `scenario` line (family walker3_scenarios), then hqp_corpus
 # derives the stress and degenerate families from them. JOBS=N simulations at a time (2).
 set -euo pipefail
@@ -66,7 +70,7 @@ case $cmd in
     for r in $(seq 1 "$rounds"); do
       for which in old new; do
         bin=$old; [ $which = new ] && bin=$new
-        dir=$out; [ $which = old ] && dir=${OLD_CORPUS_DIR:-$out}
+        dir=${NEW_CORPUS_DIR:-$out}; [ $which = old ] && dir=${OLD_CORPUS_DIR:-$out}
         HQP_CORPUS_DIR="$dir" "${pin[@]}" "$bin" --benchmark_filter="$filter" \
           --benchmark_format=json --benchmark_out="$tmp/$which.$r.json" >/dev/null
         echo "round $r: $which done"
@@ -89,11 +93,18 @@ for n in names:
 PY
     rm -rf "$tmp"
     exit 0 ;;
-  v2)
-    dest=${1:?usage: corpus.sh v2 DIR}
+  steady)
+    dest=${1:?usage: corpus.sh steady DIR}
+    need hqp_corpus
     [ -f "$out/stress.hqprec" ] || bash "$0" make
+    exec "$build/tools/hqp_corpus" steady "$out" "$dest" ;;
+  v2)
+    dest=${1:?usage: corpus.sh v2 DIR [SRC]}
+    src=${2:-$out}
+    if [ -n "${2:-}" ]; then [ -f "$src/stress.hqprec" ] || { echo "$src: no stress.hqprec" >&2; exit 2; }
+    else [ -f "$out/stress.hqprec" ] || bash "$0" make; fi
     mkdir -p "$dest"
-    python3 - "$out" "$dest" <<'PY'
+    python3 - "$src" "$dest" <<'PY'
 import glob, os, struct, sys
 src, dest = sys.argv[1], sys.argv[2]
 for f in sorted(glob.glob(f"{src}/*.hqprec")):
@@ -110,7 +121,7 @@ for f in sorted(glob.glob(f"{src}/*.hqprec")):
 PY
     exit 0 ;;
   make) ;;
-  *) echo "usage: corpus.sh make|check|oracle|bench [ARGS]|compare OLD NEW [ROUNDS]|v2 DIR" >&2; exit 2 ;;
+  *) echo "usage: corpus.sh make|check|oracle|bench [ARGS]|compare OLD NEW [ROUNDS]|steady DIR|v2 DIR [SRC]" >&2; exit 2 ;;
 esac
 need sim_demo hqp_corpus
 mkdir -p "$out/scenarios"

@@ -22,6 +22,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -504,6 +505,43 @@ int dumpCommand(const std::string& file, const std::string& out_path) {
   return 0;
 }
 
+// ---- Steady state ---------------------------------------------------------------------------
+
+// Every instance's warm start replaced by the working sets this build's solve of it ends with
+// (from its recorded warm start): a controller's next tick on a problem that did not change
+// (docs/benchmarks.md, "The steady state"). Instances, stored results and header as read.
+int steadyCommand(const std::string& dir, const std::string& out_dir) {
+  std::filesystem::create_directories(out_dir);
+  for (const char* name : kFamilies) {
+    const std::string path = dir + "/" + name + ".hqprec";
+    hqp::ProblemFileInfo info;
+    std::vector<Instance> v = hqp::readProblemFile<Wbc>(path, &info);
+    auto wbc = std::make_unique<Wbc>(info.shippedSettings());
+    int changed = 0;
+    for (Instance& in : v) {
+      hqp::loadInstance(in, *wbc, true);
+      wbc->solve();
+      const auto before = in.warm;
+      hqp::captureWarmStart(*wbc, in);
+      for (std::size_t p = 0; p < before.size(); ++p) {
+        const auto &a = before[p], &b = in.warm[p];
+        const std::size_t na = static_cast<std::size_t>(a.num_active);
+        if (a.variables != b.variables || a.num_active != b.num_active ||
+            !std::equal(a.row.begin(), a.row.begin() + na, b.row.begin()) ||
+            !std::equal(a.upper.begin(), a.upper.begin() + na, b.upper.begin())) {
+          ++changed;
+          break;
+        }
+      }
+    }
+    const std::string out = out_dir + "/" + name + ".hqprec";
+    hqp::writeProblemFile<Wbc>(out, v.data(), v.size(), info.settings,
+                               info.source + "; warm starts: the working sets each solve ends with");
+    std::printf("%s: %zu instances, %d warm starts changed\n", out.c_str(), v.size(), changed);
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -534,6 +572,10 @@ int main(int argc, char** argv) {
   auto* dmp = app.add_subcommand("dump", "instances and warm solutions as JSON (tools/hqp_oracle.py)");
   dmp->add_option("file", dump_file, "a family file")->required();
   dmp->add_option("out", dump_out, "the JSON file to write")->required();
+  std::string steady_out;
+  auto* std_ = app.add_subcommand("steady", "the families with each instance warm-started from its own solve's working sets");
+  std_->add_option("dir", dir, "folder of the family files")->required();
+  std_->add_option("out", steady_out, "folder to write them to")->required();
   CLI11_PARSE(app, argc, argv);
   try {
     if (*gen) {
@@ -545,6 +587,7 @@ int main(int argc, char** argv) {
     }
     if (*shw) return showCommand(show_file, show_k);
     if (*dmp) return dumpCommand(dump_file, dump_out);
+    if (*std_) return steadyCommand(dir, steady_out);
     return checkCommand(dir, max, tol, obj_tol, verbose);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hqp_corpus: %s\n", e.what());
