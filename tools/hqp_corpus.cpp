@@ -512,8 +512,11 @@ int dumpCommand(const std::string& file, const std::string& out_path) {
 // (docs/benchmarks.md, "The steady state"). Instances, stored results and header as read.
 int steadyCommand(const std::string& dir, const std::string& out_dir) {
   std::filesystem::create_directories(out_dir);
+  int families = 0;
   for (const char* name : kFamilies) {
     const std::string path = dir + "/" + name + ".hqprec";
+    if (!std::filesystem::exists(path)) continue;  // e.g. generate --base writes no scenarios
+    ++families;
     hqp::ProblemFileInfo info;
     std::vector<Instance> v = hqp::readProblemFile<Wbc>(path, &info);
     auto wbc = std::make_unique<Wbc>(info.shippedSettings());
@@ -539,6 +542,7 @@ int steadyCommand(const std::string& dir, const std::string& out_dir) {
                                info.source + "; warm starts: the working sets each solve ends with");
     std::printf("%s: %zu instances, %d warm starts changed\n", out.c_str(), v.size(), changed);
   }
+  if (families == 0) throw std::runtime_error(dir + ": no family file");
   return 0;
 }
 
