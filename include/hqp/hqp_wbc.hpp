@@ -907,7 +907,25 @@ class HqpWbc {
     aborted_ = deferred_;
     const auto Cw = W_.block(total_task_rows, col0, c, n);
     auto& qp = std::get<P>(qps_);
-    const int own = settings_.warm_start ? DualQp::preferredRows(qp, n, prefer_) : 0;
+    // The dual method's first order (any order of the violated rows is valid for it, and an
+    // order that ends on nearly dependent rows, NumericalFailure, may be avoided by another):
+    // on the cascade the level above's active set where it has one (its rows hold at
+    // x*_{p−1}, and most of them stay active; the method takes the most violated of these rows
+    // first, so their order does not matter), else the level's working set (the previous
+    // tick's active set, or a recorded one). The working set is not added to the level above's
+    // rows: where it is the optimum's own nearly dependent vertex (a controller's next tick on
+    // an unchanged problem) the union ended NumericalFailure on 6 stress instances (203, 242:
+    // ~150 µs through the order-free route), the level above's rows alone on 3
+    // (docs/benchmarks.md, "The steady state"); on the recorded stress family the two take
+    // 14.00 and 13.93 iterations.
+    const auto& above = result_.levels[P > 0 ? P - 1 : 0];
+    int own = 0;
+    if (P > 0 && !deferred_ && above.num_active > 0) {
+      own = std::min(above.num_active, static_cast<int>(prefer_.size()));
+      std::copy_n(above.active_row.begin(), own, prefer_.begin());
+    } else if (settings_.warm_start) {
+      own = DualQp::preferredRows(qp, n, prefer_);
+    }
     // The free step is tried unless the warm start holds rows (then the minimizer most likely
     // breaks one: the check would only add its products); decided by the working set alone,
     // so replays stay exact.
@@ -936,10 +954,9 @@ class HqpWbc {
     return true;
   }
 
-  // dualLastLevel's QP over every constraint row: bounds, then the dual method in one order
-  // (the warm start's rows in prefer_, or on the cascade the level above's), a second
-  // on the deferred path, the order-free route on the cascade. On success u_ and the active set
-  // are in lr.
+  // dualLastLevel's QP over every constraint row: bounds, then the dual method in the order
+  // dualLastLevel put in prefer_[0..own), a second on the deferred path, the order-free route on
+  // the cascade. On success u_ and the active set are in lr.
   template <int P>
   bool solveDual(int n, int col0, double min_sigma, int own, HqpLevelResult<max_active>& lr) {
     constexpr int r = LevelType<P>::task_rows;
@@ -956,26 +973,11 @@ class HqpWbc {
         return false;
       if (!dualRowBounds(i, own_begin, 0.0, cnorm_(i), i >= own_begin)) return false;
     }
-    // Any order of the violated rows is valid for the dual method, and an order that ends on
-    // nearly dependent rows (NumericalFailure) may be avoided by another. The first order is, on
-    // the cascade, the level above's active set where it has one (its rows hold at x*_{p−1},
-    // and most of them stay active; the method takes the most violated of these rows first, so
-    // their order does not matter), else the level's working set (the previous tick's active
-    // set, or a recorded one). The working set is not added to the level above's rows: where it
-    // is the optimum's own nearly dependent vertex (a controller's next tick on an unchanged
-    // problem) the union ended NumericalFailure on 6 stress instances (203, 242: ~150 µs through
-    // the order-free route), the level above's rows alone on 3 (docs/benchmarks.md, "The steady
-    // state"); on the recorded stress family the two take 14.00 and 13.93 iterations.
     // On the deferred path the method's own order (most violated first) is the second; on the
     // cascade a failed first order goes to routes that depend on no order
     // (DualActiveSetQp::solveOrderFree), before the general path's ActiveSetQp, which can end
     // on such rows too: there another order met the same rows on every stress instance seen
     // (docs/benchmarks.md, "The stress tail by phase").
-    const auto& above = result_.levels[P > 0 ? P - 1 : 0];
-    if (P > 0 && !deferred_ && above.num_active > 0) {
-      own = std::min(above.num_active, static_cast<int>(prefer_.size()));
-      std::copy_n(above.active_row.begin(), own, prefer_.begin());
-    }
     QpStatus s = dual_.solve(Cw, dlo_, dup_, c, settings_.qp, prefer_.data(), own);
     if (s == QpStatus::NumericalFailure && own > 0 && deferred_ &&
         dual_.factorize(M_, bq_, r, n, min_sigma))
