@@ -316,6 +316,7 @@ class HqpWbc {
       return result_.status;
     }
     conflict_.count = 0;
+    ns_deferred_.fill(false);
     if (defer) {
       result_.deferred_tried = true;
       deferred_ = true;
@@ -703,7 +704,15 @@ class HqpWbc {
       if (deferred_) deferredConstraintRows(n);  // the general path reads them
     }
     auto& ns = ns_[P];
-    ns.compute(M_, settings_.rank_tol * scale);
+    if constexpr (!last) {
+      // Â_p of a level above the last depends on the task rows and Q_0 … Q_{p−1} alone, not
+      // on x*: the cascade after a failed deferred attempt factors the matrix that attempt
+      // factored (bit for bit on the corpus), so it keeps that decomposition.
+      if (deferred_ || !ns_deferred_[P]) ns.compute(M_, settings_.rank_tol * scale);
+      ns_deferred_[P] = deferred_;
+    } else {
+      ns.compute(M_, settings_.rank_tol * scale);
+    }
     const int k = ns.rank();
     // Every row below (lower tasks, all constraints) into the coordinates u = Q u':
     // u' = [row-space part (k); null part (n − k)], so Z_p is the last n − k columns.
@@ -1492,6 +1501,7 @@ class HqpWbc {
   int bound_count_ = 0;
   LeastSquares ls_;
   std::array<NullSpace<capacity(max_task_rows), Nx>, sizeof...(Levels)> ns_{};  // per level: Q_p
+  std::array<bool, sizeof...(Levels)> ns_deferred_{};  // ns_[p] from this solve's deferred attempt
   std::array<bool, sizeof...(Levels)> slack_{};
   static constexpr std::array<bool, sizeof...(Levels)> slack_capable_{
       (Levels::slack && Levels::constraint_rows > 0)...};

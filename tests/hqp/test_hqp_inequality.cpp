@@ -267,6 +267,52 @@ TEST(HqpInequality, DeferredPathGivesTheCascadesOptimum) {
   EXPECT_GE(deferred_active, 40); // the last level really held rows of the levels above
 }
 
+// After a failed deferred attempt the cascade keeps that attempt's decompositions of Â_p for
+// the levels above the last (the same matrices). Only that solve's: a solve on new data that
+// makes no deferred attempt factors every level anew. Checked against a fresh solver on the
+// same data, and the cascade after a failed attempt against the brute-force cascade.
+TEST(HqpInequality, CascadeReusesOnlyItsOwnDeferredAttemptsDecompositions) {
+  std::mt19937 g(61);
+  static Wbc wbc, fresh;
+  fresh.setDeferConstraints(false);
+  int failed_attempts = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    Eigen::VectorXd x0;
+    auto L = makeLevels(trial % 4, g, &x0);
+    const bool reachable = trial % 2 == 0;  // the deferred path holds; else it mostly fails
+    if (reachable)
+      for (int p = 0; p < 3; ++p) L[static_cast<size_t>(p)].b = L[static_cast<size_t>(p)].A * x0;
+    wbc.setDeferConstraints(true);
+    fill(wbc, L);
+    wbc.resetWarmStart();
+    wbc.solve();
+    ASSERT_TRUE(wbc.result().deferred_tried) << "trial " << trial;
+    if (reachable) ASSERT_TRUE(wbc.result().deferred) << "trial " << trial;
+    if (!wbc.result().deferred) {
+      ++failed_attempts;
+      const auto ref = hqp::testing::bruteForceCascade(L, N);
+      for (int p = 0; p < 4; ++p) {
+        const double res = ref.residual[static_cast<size_t>(p)];
+        EXPECT_NEAR(wbc.result().levels[static_cast<size_t>(p)].residual, res, 1e-8 * (1.0 + res))
+            << "trial " << trial << " level " << p;
+      }
+    }
+    // New data, no deferred attempt: the same x as a solver that never saw the first.
+    const auto L2 = makeLevels(trial % 4, g);
+    wbc.setDeferConstraints(false);
+    fill(wbc, L2);
+    wbc.resetWarmStart();
+    fill(fresh, L2);
+    fresh.resetWarmStart();
+    const hqp::QpStatus s = wbc.solve(), s_fresh = fresh.solve();
+    EXPECT_EQ(s, s_fresh) << "trial " << trial;
+    const double xs = std::max(1.0, fresh.result().x.lpNorm<Eigen::Infinity>());
+    EXPECT_LT((wbc.result().x - fresh.result().x).lpNorm<Eigen::Infinity>() / xs, 1e-12)
+        << "trial " << trial;
+  }
+  EXPECT_GE(failed_attempts, 10);
+}
+
 // The deferred path's last level when its unconstrained minimizer meets every row: no row is
 // formed in its variables, the level ends with none active (docs/hqp.md, "Deferred
 // constraints"). Every target near a point strictly inside every row (no equality rows), so
