@@ -704,15 +704,11 @@ class HqpWbc {
       if (deferred_) deferredConstraintRows(n);  // the general path reads them
     }
     auto& ns = ns_[P];
-    if constexpr (!last) {
-      // Â_p of a level above the last depends on the task rows and Q_0 … Q_{p−1} alone, not
-      // on x*: the cascade after a failed deferred attempt factors the matrix that attempt
-      // factored (bit for bit on the corpus), so it keeps that decomposition.
-      if (deferred_ || !ns_deferred_[P]) ns.compute(M_, settings_.rank_tol * scale);
-      ns_deferred_[P] = deferred_;
-    } else {
-      ns.compute(M_, settings_.rank_tol * scale);
-    }
+    // Â_p of a level above the last depends on the task rows and Q_0 … Q_{p−1} alone, not on
+    // x*: the cascade after a failed deferred attempt factors the matrix that attempt factored
+    // (bit for bit on the corpus), so it keeps that decomposition.
+    if (last || deferred_ || !ns_deferred_[P]) ns.compute(M_, settings_.rank_tol * scale);
+    ns_deferred_[P] = deferred_ && !last;
     const int k = ns.rank();
     // Every row below (lower tasks, all constraints) into the coordinates u = Q u':
     // u' = [row-space part (k); null part (n − k)], so Z_p is the last n − k columns.
