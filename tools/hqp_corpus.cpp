@@ -5,13 +5,19 @@
 //       them by the seeded transformations of the list. --base FILE instead of --scenarios
 //       derives from one recording (the checked-in one, for the ctest).
 //   hqp_corpus check DIR [--max K] [--verbose]
-//       exactness: every instance warm and cold, every level Optimal, warm x* = cold x*, the
-//       level objectives against the peer cascade (peer_cascade.hpp). Exit 1 on a mismatch.
+//       exactness: every instance warm and cold, every level Optimal, warm x* = cold x* = the
+//       stored x* (or the same level objectives), the level objectives against the peer cascade
+//       (peer_cascade.hpp). Exit 1 on a mismatch.
 //   hqp_corpus show FILE K
 //       one instance per level: warm, cold and the peer (objective, status, iterations).
 //   hqp_corpus dump FILE OUT.json
 //       every instance's rows and bounds (±inf as null) with the warm solve's x and statuses,
 //       for an independent check of each level (tools/hqp_oracle.py).
+//   hqp_corpus reformulate DIR OUT [--seed S]
+//       the families in DIR written as another formulation of the same hierarchies: variables
+//       in a random order, constraint rows and task rows rescaled (weights compensating). The
+//       optima are the same up to the permutation, only the rounding differs; `check OUT`
+//       then tests that the answers do not depend on the bits the solver was tuned on.
 // Deterministic: the random numbers come from std::mt19937_64 through our own uniform and
 // normal transforms (the standard distributions differ between standard libraries).
 // The shape is Walker3's balance hierarchy (Table I), as for hqp_replay.
@@ -24,6 +30,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <random>
@@ -357,7 +364,12 @@ Tally check(const std::vector<Instance>& v, const hqp::HqpSettings& settings, co
     const double dx = scaled(x[1], x[0]);
     const bool same = dx <= tol || compareLex(fw, fc, obj_tol) == 0;
     t.x_warm_cold += same;
-    t.x_stored += scaled(x[1], in.result.x) <= tol || compareLex(fw, levelObjectives(in, in.result.x), obj_tol) == 0;
+    const bool as_stored =
+        scaled(x[1], in.result.x) <= tol || compareLex(fw, levelObjectives(in, in.result.x), obj_tol) == 0;
+    t.x_stored += as_stored;
+    if (!as_stored && status_ok[1])
+      t.notes.push_back(name + " instance " + std::to_string(k) + ": x* not the stored one (|dx| " +
+                        std::to_string(scaled(x[1], in.result.x)) + ", level objectives differ)");
     t.worst_dx = std::max(t.worst_dx, dx);
     t.worst_viol = std::max(t.worst_viol, violation(in, x[1]));
     if (!status_ok[0] || !status_ok[1] || !same)
@@ -409,7 +421,7 @@ int checkCommand(const std::string& dir, int max, double tol, double obj_tol, bo
                 t.status_cold, t.x_warm_cold, t.x_stored, t.stored_not_optimal, t.peer_equal, t.hqp_better,
                 t.peer_better, t.peer_failed, t.unique, t.active / std::max(1, t.instances));
     ok = ok && t.status_warm == t.instances && t.status_cold == t.instances && t.x_warm_cold == t.instances &&
-         t.peer_better == 0;
+         t.x_stored == t.instances && t.peer_better == 0;
     notes.insert(notes.end(), t.notes.begin(), t.notes.end());
   }
   for (std::size_t k = 0; k < notes.size() && (verbose || k < 30); ++k) std::printf("  %s\n", notes[k].c_str());
@@ -534,6 +546,70 @@ int steadyCommand(const std::string& dir, const std::string& out_dir) {
   return 0;
 }
 
+// ---- Reformulations -------------------------------------------------------------------------
+
+// The same hierarchy written another way (docs/benchmarks.md, "Reformulated corpus"):
+//  - the variables in a random order: A and D by columns, the stored x* by rows;
+//  - every constraint row times f ∈ [1/2, 2] (D_i and both bounds; ±inf stays), its stored
+//    multiplier divided by f;
+//  - every task row times g ∈ [1/2, 2] (A_i, b_i) with its weight divided by g², so that
+//    W^½ A and W^½ b, every level objective, are unchanged.
+// The feasible set and the lexicographic optimum are the same up to the permutation; the
+// factors are not powers of 2, so every product rounds differently. Warm starts name rows and
+// their sides: unchanged.
+Instance reformulated(const Instance& in, Rng& rng) {
+  Instance out = in;
+  std::array<int, NX> perm{};  // new variable j is old variable perm[j]
+  for (int j = 0; j < NX; ++j) perm[static_cast<std::size_t>(j)] = j;
+  for (int j = NX - 1; j > 0; --j) std::swap(perm[static_cast<std::size_t>(j)], perm[static_cast<std::size_t>(rng.below(j + 1))]);
+  for (int j = 0; j < NX; ++j) {
+    const int o = perm[static_cast<std::size_t>(j)];
+    out.A.col(j) = in.A.col(o);
+    out.D.col(j) = in.D.col(o);
+    out.result.x(j) = in.result.x(o);
+  }
+  const auto factor = [&] { return std::exp2(2.0 * rng.uniform() - 1.0); };
+  std::array<double, C> f{};
+  for (int i = 0; i < C; ++i) {
+    f[static_cast<std::size_t>(i)] = factor();
+    out.D.row(i) *= f[static_cast<std::size_t>(i)];
+    out.lower(i) *= f[static_cast<std::size_t>(i)];
+    out.upper(i) *= f[static_cast<std::size_t>(i)];
+  }
+  for (int i = 0; i < T; ++i) {
+    const double g = factor();
+    out.A.row(i) *= g;
+    out.b(i) *= g;
+    out.w(i) /= g * g;
+  }
+  for (auto& l : out.result.levels)
+    for (int a = 0; a < l.num_active; ++a)
+      l.multiplier[static_cast<std::size_t>(a)] /= f[static_cast<std::size_t>(l.active_row[static_cast<std::size_t>(a)])];
+  return out;
+}
+
+int reformulateCommand(const std::string& dir, const std::string& out_dir, std::uint64_t seed) {
+  std::filesystem::create_directories(out_dir);
+  int families = 0;
+  for (std::size_t fam = 0; fam < std::size(kFamilies); ++fam) {
+    const std::string path = dir + "/" + kFamilies[fam] + ".hqprec";
+    if (!std::filesystem::exists(path)) continue;
+    ++families;
+    hqp::ProblemFileInfo info;
+    std::vector<Instance> v = hqp::readProblemFile<Wbc>(path, &info);
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      Rng rng(seed * 1000003u + fam * 100003u + k);
+      v[k] = reformulated(v[k], rng);
+    }
+    const std::string out = out_dir + "/" + kFamilies[fam] + ".hqprec";
+    hqp::writeProblemFile<Wbc>(out, v.data(), v.size(), info.settings,
+                               info.source + "; reformulated (seed " + std::to_string(seed) + ")");
+    std::printf("%s: %zu instances\n", out.c_str(), v.size());
+  }
+  if (families == 0) throw std::runtime_error(dir + ": no family file");
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -568,6 +644,12 @@ int main(int argc, char** argv) {
   auto* std_ = app.add_subcommand("steady", "the families with each instance warm-started from its own solve's working sets");
   std_->add_option("dir", dir, "folder of the family files")->required();
   std_->add_option("out", steady_out, "folder to write them to")->required();
+  std::string reform_out;
+  std::uint64_t reform_seed = 1;
+  auto* ref = app.add_subcommand("reformulate", "the families as another formulation of the same hierarchies");
+  ref->add_option("dir", dir, "folder of the family files")->required();
+  ref->add_option("out", reform_out, "folder to write them to")->required();
+  ref->add_option("--seed", reform_seed, "seed of the permutation and the factors")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   try {
     if (*gen) {
@@ -580,6 +662,7 @@ int main(int argc, char** argv) {
     if (*shw) return showCommand(show_file, show_k);
     if (*dmp) return dumpCommand(dump_file, dump_out);
     if (*std_) return steadyCommand(dir, steady_out);
+    if (*ref) return reformulateCommand(dir, reform_out, reform_seed);
     return checkCommand(dir, max, tol, obj_tol, verbose);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hqp_corpus: %s\n", e.what());
