@@ -517,33 +517,44 @@ int dumpCommand(const std::string& file, const std::string& out_path) {
   return 0;
 }
 
-// ---- Steady state ---------------------------------------------------------------------------
+// ---- Rewritten families (steady, reformulate) -----------------------------------------------
+
+// Every family file in dir passed through rewrite(info, family index, instances) and written to
+// out_dir, note appended to its source; families absent from dir are skipped (generate --base
+// writes no scenarios).
+template <class Rewrite>
+int rewriteFamilies(const std::string& dir, const std::string& out_dir, const std::string& note,
+                    Rewrite&& rewrite) {
+  std::filesystem::create_directories(out_dir);
+  int families = 0;
+  for (std::size_t fam = 0; fam < std::size(kFamilies); ++fam) {
+    const std::string path = dir + "/" + kFamilies[fam] + ".hqprec";
+    if (!std::filesystem::exists(path)) continue;
+    ++families;
+    hqp::ProblemFileInfo info;
+    std::vector<Instance> v = hqp::readProblemFile<Wbc>(path, &info);
+    rewrite(info, fam, v);
+    const std::string out = out_dir + "/" + kFamilies[fam] + ".hqprec";
+    hqp::writeProblemFile<Wbc>(out, v.data(), v.size(), info.settings, info.source + "; " + note);
+    std::printf("%s: %zu instances\n", out.c_str(), v.size());
+  }
+  if (families == 0) throw std::runtime_error(dir + ": no family file");
+  return 0;
+}
 
 // Every instance's warm start replaced by the working sets this build's solve of it ends with
 // (from its recorded warm start): a controller's next tick on a problem that did not change
 // (docs/benchmarks.md, "The steady state"). Instances, stored results and header as read.
 int steadyCommand(const std::string& dir, const std::string& out_dir) {
-  std::filesystem::create_directories(out_dir);
-  int families = 0;
-  for (const char* name : kFamilies) {
-    const std::string path = dir + "/" + name + ".hqprec";
-    if (!std::filesystem::exists(path)) continue;  // e.g. generate --base writes no scenarios
-    ++families;
-    hqp::ProblemFileInfo info;
-    std::vector<Instance> v = hqp::readProblemFile<Wbc>(path, &info);
-    auto wbc = std::make_unique<Wbc>(info.shippedSettings());
-    for (Instance& in : v) {
-      hqp::loadInstance(in, *wbc, true);
-      wbc->solve();
-      hqp::captureWarmStart(*wbc, in);
-    }
-    const std::string out = out_dir + "/" + name + ".hqprec";
-    hqp::writeProblemFile<Wbc>(out, v.data(), v.size(), info.settings,
-                               info.source + "; warm starts: the working sets each solve ends with");
-    std::printf("%s: %zu instances\n", out.c_str(), v.size());
-  }
-  if (families == 0) throw std::runtime_error(dir + ": no family file");
-  return 0;
+  return rewriteFamilies(dir, out_dir, "warm starts: the working sets each solve ends with",
+                         [](const hqp::ProblemFileInfo& info, std::size_t, std::vector<Instance>& v) {
+                           auto wbc = std::make_unique<Wbc>(info.shippedSettings());
+                           for (Instance& in : v) {
+                             hqp::loadInstance(in, *wbc, true);
+                             wbc->solve();
+                             hqp::captureWarmStart(*wbc, in);
+                           }
+                         });
 }
 
 // ---- Reformulations -------------------------------------------------------------------------
@@ -589,25 +600,13 @@ Instance reformulated(const Instance& in, Rng& rng) {
 }
 
 int reformulateCommand(const std::string& dir, const std::string& out_dir, std::uint64_t seed) {
-  std::filesystem::create_directories(out_dir);
-  int families = 0;
-  for (std::size_t fam = 0; fam < std::size(kFamilies); ++fam) {
-    const std::string path = dir + "/" + kFamilies[fam] + ".hqprec";
-    if (!std::filesystem::exists(path)) continue;
-    ++families;
-    hqp::ProblemFileInfo info;
-    std::vector<Instance> v = hqp::readProblemFile<Wbc>(path, &info);
-    for (std::size_t k = 0; k < v.size(); ++k) {
-      Rng rng(seed * 1000003u + fam * 100003u + k);
-      v[k] = reformulated(v[k], rng);
-    }
-    const std::string out = out_dir + "/" + kFamilies[fam] + ".hqprec";
-    hqp::writeProblemFile<Wbc>(out, v.data(), v.size(), info.settings,
-                               info.source + "; reformulated (seed " + std::to_string(seed) + ")");
-    std::printf("%s: %zu instances\n", out.c_str(), v.size());
-  }
-  if (families == 0) throw std::runtime_error(dir + ": no family file");
-  return 0;
+  return rewriteFamilies(dir, out_dir, "reformulated (seed " + std::to_string(seed) + ")",
+                         [seed](const hqp::ProblemFileInfo&, std::size_t fam, std::vector<Instance>& v) {
+                           for (std::size_t k = 0; k < v.size(); ++k) {
+                             Rng rng(seed * 1000003u + fam * 100003u + k);
+                             v[k] = reformulated(v[k], rng);
+                           }
+                         });
 }
 
 }  // namespace
