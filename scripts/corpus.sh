@@ -130,7 +130,7 @@ for f in sorted(glob.glob(f"{src}/*.hqprec")):
 PY
     exit 0 ;;
   make) ;;
-  *) echo "usage: corpus.sh make|check|oracle|bench [ARGS]|compare OLD NEW [ROUNDS]|steady DIR|v2 DIR [SRC]" >&2; exit 2 ;;
+  *) echo "usage: corpus.sh make|check|oracle|bench [ARGS]|compare OLD NEW [ROUNDS]|steady DIR|reformulate DIR [SEED]|v2 DIR [SRC]" >&2; exit 2 ;;
 esac
 need sim_demo hqp_corpus
 mkdir -p "$out/scenarios"
