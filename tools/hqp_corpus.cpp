@@ -33,6 +33,7 @@
 #include <iterator>
 #include <map>
 #include <memory>
+#include <numeric>
 #include <random>
 #include <sstream>
 #include <string>
@@ -571,10 +572,10 @@ int steadyCommand(const std::string& dir, const std::string& out_dir) {
 Instance reformulated(const Instance& in, Rng& rng) {
   Instance out = in;
   std::array<int, NX> perm{};  // new variable j is old variable perm[j]
-  for (int j = 0; j < NX; ++j) perm[static_cast<std::size_t>(j)] = j;
-  for (int j = NX - 1; j > 0; --j) std::swap(perm[static_cast<std::size_t>(j)], perm[static_cast<std::size_t>(rng.below(j + 1))]);
+  std::iota(perm.begin(), perm.end(), 0);
+  for (int j = NX - 1; j > 0; --j) std::swap(perm[std::size_t(j)], perm[std::size_t(rng.below(j + 1))]);
   for (int j = 0; j < NX; ++j) {
-    const int o = perm[static_cast<std::size_t>(j)];
+    const int o = perm[std::size_t(j)];
     out.A.col(j) = in.A.col(o);
     out.D.col(j) = in.D.col(o);
     out.result.x(j) = in.result.x(o);
@@ -582,10 +583,10 @@ Instance reformulated(const Instance& in, Rng& rng) {
   const auto factor = [&] { return std::exp2(2.0 * rng.uniform() - 1.0); };
   std::array<double, C> f{};
   for (int i = 0; i < C; ++i) {
-    f[static_cast<std::size_t>(i)] = factor();
-    out.D.row(i) *= f[static_cast<std::size_t>(i)];
-    out.lower(i) *= f[static_cast<std::size_t>(i)];
-    out.upper(i) *= f[static_cast<std::size_t>(i)];
+    const double fi = f[std::size_t(i)] = factor();
+    out.D.row(i) *= fi;
+    out.lower(i) *= fi;
+    out.upper(i) *= fi;
   }
   for (int i = 0; i < T; ++i) {
     const double g = factor();
@@ -595,7 +596,7 @@ Instance reformulated(const Instance& in, Rng& rng) {
   }
   for (auto& l : out.result.levels)
     for (int a = 0; a < l.num_active; ++a)
-      l.multiplier[static_cast<std::size_t>(a)] /= f[static_cast<std::size_t>(l.active_row[static_cast<std::size_t>(a)])];
+      l.multiplier[std::size_t(a)] /= f[std::size_t(l.active_row[std::size_t(a)])];
   return out;
 }
 
