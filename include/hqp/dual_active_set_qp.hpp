@@ -639,18 +639,32 @@ class DualActiveSetQp {
   // them (after up to two refine() steps where they fail), and the stationarity residual
   // RᵀR x − Rᵀ(Q_Aᵀ b) + Σ ±u_k c_k = Aᵀ(A x − b) + Σ ±u_k c_k at rounding level relative to
   // the gradient's terms, or else relative to its terms with the multipliers' and a duality
-  // gap of at most kGapTol. Rounding with a nearly singular A shows up here rather than as a
-  // wrong Optimal.
+  // gap of at most kGapTol; where the active rows' multipliers fail that, multipliers fitted
+  // afresh on the rows at their bounds (refitted()). Rounding with a nearly singular A shows
+  // up here rather than as a wrong Optimal.
   template <class MatC, class VecL, class VecU>
   QpStatus verified(const MatC& C, const VecL& lower, const VecU& upper, int m,
                     const QpSettings& settings) {
-    const int n = n_;
-    if (!x_.allFinite()) return QpStatus::NumericalFailure;
-    bool held = rowsHold(C, lower, upper, m, settings.feasibility_tol);
+    if (!x_.allFinite() || !feasible(C, lower, upper, m, settings.feasibility_tol))
+      return QpStatus::NumericalFailure;
+    if (certified(C, lower, upper)) return QpStatus::Optimal;
+    return refitted(C, lower, upper, m, settings);
+  }
+
+  // x finite; the rows as rowsHold checks them, after up to two refine() steps where they fail.
+  template <class MatC, class VecL, class VecU>
+  bool feasible(const MatC& C, const VecL& lower, const VecU& upper, int m, double tol) {
+    bool held = rowsHold(C, lower, upper, m, tol);
     for (int pass = 0; pass < 2 && !held; ++pass)
-      held = refine(C, lower, upper, m, settings.feasibility_tol) &&
-             rowsHold(C, lower, upper, m, settings.feasibility_tol);
-    if (!held) return QpStatus::NumericalFailure;
+      held = refine(C, lower, upper, m, tol) && rowsHold(C, lower, upper, m, tol);
+    return held;
+  }
+
+  // verified()'s optimality test of x with the active rows' multipliers u_ (rows hold; cx_ =
+  // C x). Leaves z_ = R x − c (the gradient whitened: R⁻ᵀ g) and gap_allowed_.
+  template <class MatC, class VecL, class VecU>
+  bool certified(const MatC& C, const VecL& lower, const VecU& upper) {
+    const int n = n_;
     // g = Rᵀ(R x − c), R upper triangular in F_.
     const auto R = F_.topLeftCorner(n, n).template triangularView<Eigen::Upper>();
     z_.head(n).noalias() = R * x_;
@@ -668,8 +682,9 @@ class DualActiveSetQp {
       scale += std::abs(u_(k)) * C.row(row_(k)).head(n).cwiseAbs().maxCoeff();
     }
     const double res = r_.head(n).cwiseAbs().maxCoeff();
-    if (res <= kStationarityTol * gscale) return QpStatus::Optimal;
-    if (!(res <= kStationarityTol * scale)) return QpStatus::NumericalFailure;
+    gap_allowed_ = kGapTol * 0.5 * fs * fs;
+    if (res <= kStationarityTol * gscale) return true;
+    if (!(res <= kStationarityTol * scale)) return false;
     // Stationary only relative to the multipliers' terms. On nearly dependent active rows
     // they grow like 1/σ_min, x drifts off the optimum, and that test alone passed an
     // "Optimal" 2× above the optimum on a stress instance (docs/hqp.md, "The dual method's
@@ -682,7 +697,62 @@ class DualActiveSetQp {
       const int j = row_(k);
       gap += u_(k) * std::abs(cx_(j) - (upper_(k) ? upper(j) : lower(j)));
     }
-    return gap <= kGapTol * 0.5 * fs * fs ? QpStatus::Optimal : QpStatus::NumericalFailure;
+    return gap <= gap_allowed_;
+  }
+
+  // Where the active rows' multipliers fail certified(): on nearly dependent active rows they
+  // are ~1/σ_min noise (1e6 times the gradient on a reformulated stress instance, a gap 670
+  // times the allowed one) although x may lie at the optimum's vertex but for a row not yet
+  // taken. Multipliers fitted afresh: μ ≥ 0 minimizing ‖z − Σ μ_j R⁻ᵀn_j‖ (z = R⁻ᵀg, n_j = ±c_j
+  // the normal of a row side within `slack` of its bound, scaled as rowsHold) by the NNLS,
+  // whose residual is stable where μ is not; its passive rows (numerically independent) become
+  // the active set, x is moved onto their bounds (feasible()), and certified() judges the result
+  // (weak duality bounds f(x) − f* by the gap for any μ ≥ 0, so no other test is needed). The
+  // slack 1e-6 first, then 1e-2 (a row of the optimum's vertex 1e-3 off at x). NumericalFailure,
+  // x as on entry, if neither passes.
+  template <class MatC, class VecL, class VecU>
+  QpStatus refitted(const MatC& C, const VecL& lower, const VecU& upper, int m,
+                    const QpSettings& settings) {
+    const int n = n_;
+    const auto Rinv = Jr_.topLeftCorner(n, n);  // upper triangular, zero below (factorize)
+    auto& E = ldp_.E();
+    xs_ = x_;
+    ldp_.f().head(n) = z_.head(n);  // the NNLS leaves f as it is
+    for (const double slack : {1e-6, 1e-2}) {
+      int cols = 0;
+      for (int j = 0; j < m; ++j) {
+        const double v = cx_(j) * rinv_(j), t = slack * (1.0 + std::abs(v));
+        for (int side = 0; side < 2; ++side) {
+          const bool up = side == 1;
+          const double bound = up ? upper(j) : lower(j);
+          if (!(std::abs(bound) < kInf) || !((up ? bound - cx_(j) : cx_(j) - bound) * rinv_(j) <= t))
+            continue;
+          E.col(cols).head(n).noalias() =
+              (up ? -1.0 : 1.0) * (Rinv.transpose() * C.row(j).head(n).transpose());
+          ldp_row_(cols) = up ? -1 - j : j;
+          ++cols;
+        }
+      }
+      if (cols == 0 || !ldp_.solve(n, cols, decltype(ldp_)::iterationCap(settings.max_iterations, cols)) ||
+          !(0.5 * ldp_.residual().head(n).squaredNorm() <= 0.5 * gap_allowed_))
+        continue;  // the gradient is not in the cone of these rows' normals: x is not optimal
+      for (int k = 0; k < q_; ++k) active_(row_(k)) = 0;
+      q_ = 0;
+      for (int k = 0; k < ldp_.numPassive() && q_ < MaxN; ++k) {
+        const int col = ldp_.passive(k), code = ldp_row_(col);
+        const int j = code < 0 ? -1 - code : code;
+        row_(q_) = j;
+        upper_(q_) = code < 0 ? 1 : 0;
+        u_(q_) = ldp_.mu()(col);
+        active_(j) = 1;
+        ++q_;
+      }
+      const double tol = settings.feasibility_tol;
+      if (feasible(C, lower, upper, m, tol) && certified(C, lower, upper)) return QpStatus::Optimal;
+      x_ = xs_;
+      rowsHold(C, lower, upper, m, tol);  // cx_ = C x again for the next slack
+    }
+    return QpStatus::NumericalFailure;
   }
 
   bool factorized_ = false;
@@ -696,7 +766,8 @@ class DualActiveSetQp {
   Eigen::Matrix<int, MaxN, 1> row_, upper_;
   Eigen::Matrix<double, MaxIneq, 1> cx_, rinv_;
   Eigen::Matrix<int, MaxIneq, 1> active_, prefer_;
-  VectorX x0_, x_;
+  VectorX x0_, x_, xs_;  // xs_: refitted()'s entry point
+  double gap_allowed_ = 0.0;  // certified(): kGapTol · ½ (‖R x‖ + ‖c‖)²
   detail::NonNegativeLeastSquares<MaxN + 1, 2 * MaxIneq> ldp_;  // leastDistance()
   Eigen::Matrix<double, 2 * MaxIneq, 1> ldp_scale_;  // its columns: the row's ‖R⁻ᵀcᵀ‖
   Eigen::Matrix<int, 2 * MaxIneq, 1> ldp_row_;       // row j at lower: j, at upper: −1 − j

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -21,6 +22,7 @@ struct RecordedQp {
   double min_sigma = 0.0;
   Eigen::MatrixXd A, C;
   Eigen::VectorXd b, lower, upper;
+  std::vector<int> first_order;  // rows the dual method takes first (the level above's)
 };
 
 RecordedQp readQp(const char* path) {
@@ -47,6 +49,8 @@ RecordedQp readQp(const char* path) {
     for (int j = 0; j < q.n; ++j) q.C(i, j) = number();
   for (int i = 0; i < q.m; ++i) q.lower(i) = number();
   for (int i = 0; i < q.m; ++i) q.upper(i) = number();
+  q.first_order.resize(static_cast<std::size_t>(own));
+  for (int& row : q.first_order) in >> row;
   EXPECT_TRUE(in.good()) << path;
   return q;
 }
@@ -130,3 +134,37 @@ TEST(QpDualFinalCheck, WedgeOfNearlyOppositeRowsIsOptimalWithItsLargeMultipliers
 }
 
 }  // namespace
+
+// Stress instance 203 written another way (variables permuted, rows rescaled: `hqp_corpus
+// reformulate --seed 1`), its last level as the dual method sees it in a clang -march=native
+// build. Every route ends on the optimum's vertex, nine nearly dependent rows, but its
+// multipliers there are ~1/σ_min noise: the first order's and the order-free route's points
+// ended NumericalFailure (a duality gap hundreds of times the allowed one) in that build, the
+// plain order's in GCC builds with and without -march=native. Multipliers fitted afresh on the
+// rows at their bounds (DualActiveSetQp::refitted) certify it. The reference is independent: the
+// vertex of those nine rows (17, 13, 6, 24, 27, 15, 22, 0, 19) solved in 60-digit arithmetic
+// (mpmath), ‖A x − b‖² = 4803.293002690, with every multiplier of g = Σ μ n positive there
+// (0.36 … 4.6e7), so that vertex is the optimum of the QP on those rows.
+TEST(QpDualFinalCheck, VertexWithNoiseMultipliersIsCertifiedByRefittedOnes) {
+  const RecordedQp q = readQp(HQP_DUAL_REFITTED_QP_FILE);
+  ASSERT_EQ(q.n, 9);
+  ASSERT_EQ(q.m, 30);
+  ASSERT_EQ(q.first_order.size(), 10u);
+  constexpr double kOptimum = 4803.293002690;
+  hqp::DualActiveSetQp<15, 15, 60> qp;
+  for (int route = 0; route < 3; ++route) {
+    ASSERT_TRUE(qp.factorize(q.A, q.b, q.r, q.n, q.min_sigma));
+    const int own = static_cast<int>(q.first_order.size());
+    const hqp::QpStatus s =
+        route == 0   ? qp.solve(q.C, q.lower, q.upper, q.m, {}, q.first_order.data(), own)
+        : route == 1 ? qp.solve(q.C, q.lower, q.upper, q.m, {})
+                     : qp.solveOrderFree(q.C, q.lower, q.upper, q.m, {});
+    ASSERT_EQ(s, hqp::QpStatus::Optimal) << "route " << route;
+    const Eigen::VectorXd x = qp.x().head(q.n);
+    EXPECT_LE(violation(q, x), 1e-9 * (1.0 + x.norm())) << "route " << route;
+    // A row 1e-13 inside its bound moves the objective by μ · 1e-13 ≈ 5e-6 here.
+    EXPECT_NEAR((q.A * x - q.b).squaredNorm(), kOptimum, 1e-8 * kOptimum) << "route " << route;
+    EXPECT_EQ(qp.numActive(), 9) << "route " << route;
+    for (int k = 0; k < qp.numActive(); ++k) EXPECT_GE(qp.multiplier(k), 0.0) << "route " << route;
+  }
+}
