@@ -647,8 +647,9 @@ class DualActiveSetQp {
                     const QpSettings& settings) {
     if (!x_.allFinite() || !feasible(C, lower, upper, m, settings.feasibility_tol))
       return QpStatus::NumericalFailure;
-    if (certified(C, lower, upper)) return QpStatus::Optimal;
-    return refitted(C, lower, upper, m, settings);
+    double allowed = 0.0;
+    if (certified(C, lower, upper, allowed)) return QpStatus::Optimal;
+    return refitted(C, lower, upper, m, settings, allowed);
   }
 
   // x finite; the rows as rowsHold checks them, after up to two refine() steps where they fail.
@@ -661,9 +662,9 @@ class DualActiveSetQp {
   }
 
   // verified()'s optimality test of x with the active rows' multipliers u_ (rows hold; cx_ =
-  // C x). Leaves z_ = R x − c (the gradient whitened: R⁻ᵀ g) and gap_allowed_.
+  // C x). Leaves z_ = R x − c (the gradient whitened: R⁻ᵀ g); allowed = the gap it accepts.
   template <class MatC, class VecL, class VecU>
-  bool certified(const MatC& C, const VecL& lower, const VecU& upper) {
+  bool certified(const MatC& C, const VecL& lower, const VecU& upper, double& allowed) {
     const int n = n_;
     // g = Rᵀ(R x − c), R upper triangular in F_.
     const auto R = F_.topLeftCorner(n, n).template triangularView<Eigen::Upper>();
@@ -682,7 +683,7 @@ class DualActiveSetQp {
       scale += std::abs(u_(k)) * C.row(row_(k)).head(n).cwiseAbs().maxCoeff();
     }
     const double res = r_.head(n).cwiseAbs().maxCoeff();
-    gap_allowed_ = kGapTol * 0.5 * fs * fs;
+    allowed = kGapTol * 0.5 * fs * fs;
     if (res <= kStationarityTol * gscale) return true;
     if (!(res <= kStationarityTol * scale)) return false;
     // Stationary only relative to the multipliers' terms. On nearly dependent active rows
@@ -697,7 +698,7 @@ class DualActiveSetQp {
       const int j = row_(k);
       gap += u_(k) * std::abs(cx_(j) - (upper_(k) ? upper(j) : lower(j)));
     }
-    return gap <= gap_allowed_;
+    return gap <= allowed;
   }
 
   // Where the active rows' multipliers fail certified(): on nearly dependent active rows they
@@ -709,14 +710,20 @@ class DualActiveSetQp {
   // the active set, x is moved onto their bounds (feasible()), and certified() judges the result
   // (weak duality bounds f(x) − f* by the gap for any μ ≥ 0, so no other test is needed). The
   // slack 1e-6 first, then 1e-2 (a row of the optimum's vertex 1e-3 off at x). NumericalFailure,
-  // x as on entry, if neither passes.
+  // x and the active set as on entry (the order-free route and the hierarchy read the set after
+  // a failure), if neither passes.
   template <class MatC, class VecL, class VecU>
   QpStatus refitted(const MatC& C, const VecL& lower, const VecU& upper, int m,
-                    const QpSettings& settings) {
+                    const QpSettings& settings, double allowed) {
     const int n = n_;
     const auto Rinv = Jr_.topLeftCorner(n, n);  // upper triangular, zero below (factorize)
     auto& E = ldp_.E();
     xs_ = x_;
+    const int qs = q_;
+    rows_s_.head(qs) = row_.head(qs);
+    upper_s_.head(qs) = upper_.head(qs);
+    u_s_.head(qs) = u_.head(qs);
+    active_s_.head(m) = active_.head(m);
     ldp_.f().head(n) = z_.head(n);  // the NNLS leaves f as it is
     for (const double slack : {1e-6, 1e-2}) {
       int cols = 0;
@@ -734,7 +741,7 @@ class DualActiveSetQp {
         }
       }
       if (cols == 0 || !ldp_.solve(n, cols, decltype(ldp_)::iterationCap(settings.max_iterations, cols)) ||
-          !(0.5 * ldp_.residual().head(n).squaredNorm() <= 0.5 * gap_allowed_))
+          !(0.5 * ldp_.residual().head(n).squaredNorm() <= 0.5 * allowed))
         continue;  // the gradient is not in the cone of these rows' normals: x is not optimal
       for (int k = 0; k < q_; ++k) active_(row_(k)) = 0;
       q_ = 0;
@@ -748,8 +755,14 @@ class DualActiveSetQp {
         ++q_;
       }
       const double tol = settings.feasibility_tol;
-      if (feasible(C, lower, upper, m, tol) && certified(C, lower, upper)) return QpStatus::Optimal;
+      double now = 0.0;
+      if (feasible(C, lower, upper, m, tol) && certified(C, lower, upper, now)) return QpStatus::Optimal;
       x_ = xs_;
+      q_ = qs;
+      row_.head(qs) = rows_s_.head(qs);
+      upper_.head(qs) = upper_s_.head(qs);
+      u_.head(qs) = u_s_.head(qs);
+      active_.head(m) = active_s_.head(m);
       rowsHold(C, lower, upper, m, tol);  // cx_ = C x again for the next slack
     }
     return QpStatus::NumericalFailure;
@@ -766,8 +779,10 @@ class DualActiveSetQp {
   Eigen::Matrix<int, MaxN, 1> row_, upper_;
   Eigen::Matrix<double, MaxIneq, 1> cx_, rinv_;
   Eigen::Matrix<int, MaxIneq, 1> active_, prefer_;
-  VectorX x0_, x_, xs_;  // xs_: refitted()'s entry point
-  double gap_allowed_ = 0.0;  // certified(): kGapTol · ½ (‖R x‖ + ‖c‖)²
+  VectorX x0_, x_, xs_;  // xs_: refitted()'s entry point, with its active set:
+  Eigen::Matrix<int, MaxN, 1> rows_s_, upper_s_;
+  Eigen::Matrix<double, MaxN, 1> u_s_;
+  Eigen::Matrix<int, MaxIneq, 1> active_s_;
   detail::NonNegativeLeastSquares<MaxN + 1, 2 * MaxIneq> ldp_;  // leastDistance()
   Eigen::Matrix<double, 2 * MaxIneq, 1> ldp_scale_;  // its columns: the row's ‖R⁻ᵀcᵀ‖
   Eigen::Matrix<int, 2 * MaxIneq, 1> ldp_row_;       // row j at lower: j, at upper: −1 − j
