@@ -652,7 +652,7 @@ class DualActiveSetQp {
     return refitted(C, lower, upper, m, settings, allowed);
   }
 
-  // x finite; the rows as rowsHold checks them, after up to two refine() steps where they fail.
+  // The rows as rowsHold checks them, after up to two refine() steps where they fail.
   template <class MatC, class VecL, class VecU>
   bool feasible(const MatC& C, const VecL& lower, const VecU& upper, int m, double tol) {
     bool held = rowsHold(C, lower, upper, m, tol);
