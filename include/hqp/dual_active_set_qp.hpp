@@ -487,16 +487,23 @@ class DualActiveSetQp {
     x_.noalias() += Rinv * z_.head(n);
     // The passive columns are the active row sides: w = Ĝᵀμ / r(n), so ĝ's multiplier is
     // μ / r(n), the row's that divided by gn (the row was divided by it).
+    addPassiveRows([&](double mu, int col) { return mu / r(n) / ldp_scale_(col); });
+    return verified(C, lower, upper, m, settings);
+  }
+
+  // The NNLS's passive columns (row sides coded in ldp_row_) appended to the active set, the
+  // multiplier of column col as multiplier(μ_col, col).
+  template <class Multiplier>
+  void addPassiveRows(Multiplier&& multiplier) {
     for (int k = 0; k < ldp_.numPassive() && q_ < MaxN; ++k) {
       const int col = ldp_.passive(k), code = ldp_row_(col);
       const int j = code < 0 ? -1 - code : code;
       row_(q_) = j;
       upper_(q_) = code < 0 ? 1 : 0;
-      u_(q_) = ldp_.mu()(col) / r(n) / ldp_scale_(col);
+      u_(q_) = multiplier(ldp_.mu()(col), col);
       active_(j) = 1;
       ++q_;
     }
-    return verified(C, lower, upper, m, settings);
   }
 
   // Rotation (a, b) → (ρ, 0) applied to columns i, i + 1 of J: J ← J Gᵀ.
@@ -745,15 +752,7 @@ class DualActiveSetQp {
         continue;  // the gradient is not in the cone of these rows' normals: x is not optimal
       for (int k = 0; k < q_; ++k) active_(row_(k)) = 0;
       q_ = 0;
-      for (int k = 0; k < ldp_.numPassive() && q_ < MaxN; ++k) {
-        const int col = ldp_.passive(k), code = ldp_row_(col);
-        const int j = code < 0 ? -1 - code : code;
-        row_(q_) = j;
-        upper_(q_) = code < 0 ? 1 : 0;
-        u_(q_) = ldp_.mu()(col);
-        active_(j) = 1;
-        ++q_;
-      }
+      addPassiveRows([](double mu, int) { return mu; });
       const double tol = settings.feasibility_tol;
       double now = 0.0;
       if (feasible(C, lower, upper, m, tol) && certified(C, lower, upper, now)) return QpStatus::Optimal;
