@@ -114,15 +114,28 @@ class DualActiveSetQp {
   // σ_min(A): the objective is then strictly convex by at least that margin.
   template <class MatA, class VecB>
   bool factorize(const MatA& A, const VecB& b, int r, int n, double min_sigma) noexcept {
-    return factorizeMapped(mapColumns(A), mapVector(b), r, n, min_sigma);
+    return factorizeMapped(mapColumns(A), mapVector(b), r, n, min_sigma, n);
+  }
+
+  // factorize() for A = [A₁ 0; 0 D] and b = [b₁; 0], where A₁ is the first k columns of the
+  // top r − (n − k) rows and D is diagonal (n − k nonzero entries), as the dual start's
+  // stacked objective: every zero must be exact. The same R, J and minimizer as factorize()
+  // (its Householder steps on the zero blocks only move zeros; a zero's sign may differ), for
+  // the QR of A₁ alone and two-row steps on D's columns.
+  template <class MatA, class VecB>
+  bool factorizeBlockDiagonal(const MatA& A, const VecB& b, int r, int n, int k,
+                              double min_sigma) noexcept {
+    if (k < 0 || k > n) return false;
+    return factorizeMapped(mapColumns(A), mapVector(b), r, n, min_sigma, k);
   }
 
  private:
   // factorize() on A and b as maps: the method's code is compiled once per solver type,
   // whatever block or matrix type the caller holds its data in (docs/hqp.md, "One copy of
   // the dual method's code").
+  // k < n: A = [A₁ 0; 0 D] as factorizeBlockDiagonal() states; rt = r − (n − k) rows of A₁.
   bool factorizeMapped(const ColumnsMap& A, const VectorMap& b, int r, int n,
-                       double min_sigma) noexcept {
+                       double min_sigma, int k) noexcept {
     n_ = n;
     factorized_ = false;
     if (n <= 0 || n > MaxN || r < n || r > MaxRows) return false;
@@ -133,29 +146,31 @@ class DualActiveSetQp {
     min_sigma = std::max(min_sigma, kMinSigmaFloor * anorm);
     // Householder QR, column by column on raw columns (at ≤ 15 x 9, Eigen's block
     // expressions cost more than the flops): H_i = I − τ [1; v][1; v]ᵀ, v below the diagonal.
-    for (int i = 0; i < n; ++i) {
+    // With k < n only A₁'s rows and columns (and c) take part: the rest of them is zero.
+    const int rt = r - (n - k);
+    for (int i = 0; i < k; ++i) {
       double* v = &F_(0, i);
       double tail = 0.0;
-      for (int l = i + 1; l < r; ++l) tail += v[l] * v[l];
+      for (int l = i + 1; l < rt; ++l) tail += v[l] * v[l];
       const double a = v[i];
       double tau = 0.0, beta = a;
       if (tail > 0.0) {
         beta = -std::copysign(std::sqrt(a * a + tail), a);
         tau = (beta - a) / beta;
         const double inv = 1.0 / (a - beta);
-        for (int l = i + 1; l < r; ++l) v[l] *= inv;
+        for (int l = i + 1; l < rt; ++l) v[l] *= inv;
       }
       if (!(beta != 0.0) || !std::isfinite(beta)) return false;
       v[i] = beta;
       if (tau == 0.0) continue;
-      // Columns i+1 .. n−1, then c (j = n), two at a time: their dot products are independent
+      // Columns i+1 .. k−1, then c (j = k), two at a time: their dot products are independent
       // chains (each summed in its own order, so the result does not change).
       int j = i + 1;
-      for (; j + 1 <= n; j += 2) {
+      for (; j + 1 <= k; j += 2) {
         double* x = &F_(0, j);
-        double* y = j + 1 < n ? &F_(0, j + 1) : c_.data();
+        double* y = j + 1 < k ? &F_(0, j + 1) : c_.data();
         double t = x[i], s = y[i];
-        for (int l = i + 1; l < r; ++l) {
+        for (int l = i + 1; l < rt; ++l) {
           t += v[l] * x[l];
           s += v[l] * y[l];
         }
@@ -163,19 +178,38 @@ class DualActiveSetQp {
         s *= tau;
         x[i] -= t;
         y[i] -= s;
-        for (int l = i + 1; l < r; ++l) {
+        for (int l = i + 1; l < rt; ++l) {
           x[l] -= t * v[l];
           y[l] -= s * v[l];
         }
       }
-      if (j <= n) {
-        double* x = j < n ? &F_(0, j) : c_.data();
+      if (j <= k) {
+        double* x = j < k ? &F_(0, j) : c_.data();
         double t = x[i];
-        for (int l = i + 1; l < r; ++l) t += v[l] * x[l];
+        for (int l = i + 1; l < rt; ++l) t += v[l] * x[l];
         t *= tau;
         x[i] -= t;
-        for (int l = i + 1; l < r; ++l) x[l] -= t * v[l];
+        for (int l = i + 1; l < rt; ++l) x[l] -= t * v[l];
       }
+    }
+    // D's columns: column i holds d at row s = rt + i − k alone, and c there is still 0, so
+    // its step touches rows i and s of c only (none if s = i: τ = 0).
+    for (int i = k; i < n; ++i) {
+      double* v = &F_(0, i);
+      const int s = rt + i - k;
+      const double a = v[i];
+      if (s == i) {
+        if (!(a != 0.0) || !std::isfinite(a)) return false;
+        continue;
+      }
+      const double beta = -std::copysign(std::sqrt(a * a + v[s] * v[s]), a);
+      if (!(beta != 0.0) || !std::isfinite(beta)) return false;
+      const double tau = (beta - a) / beta;
+      v[s] *= 1.0 / (a - beta);
+      v[i] = beta;
+      const double t = (c_(i) + v[s] * c_(s)) * tau;
+      c_(i) -= t;
+      c_(s) -= t * v[s];
     }
     // J = R⁻¹ from R J = I, every column at once: row i of J (all columns, padded to whole
     // vectors) is divided by R_ii, then taken off the rows above. Column j sees the steps of a
@@ -185,7 +219,8 @@ class DualActiveSetQp {
     for (int i = 0; i < n; ++i) Jr_(i, i) = 1.0;
     for (int i = n - 1; i >= 0; --i) {
       Jr_.row(i) /= F_(i, i);
-      for (int l = 0; l < i; ++l) Jr_.row(l) -= F_(l, i) * Jr_.row(i);
+      if (i < k)  // rows above D's columns: F_(l, i) = 0 there
+        for (int l = 0; l < i; ++l) Jr_.row(l) -= F_(l, i) * Jr_.row(i);
     }
     J_.topLeftCorner(n, n) = Jr_.topLeftCorner(n, n).template triangularView<Eigen::Upper>();
     // ‖R⁻¹‖_F² over the upper triangle (the rest is zero). Summed by hand: GCC's loop analysis

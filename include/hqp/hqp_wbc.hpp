@@ -1288,7 +1288,7 @@ class HqpWbc {
     for (int i = 0; i < m; ++i) Fs_(r + i, k + i) = sd;
     fs_.setZero(r + m);
     fs_.head(r) = qp.b();
-    if (!dual_.factorize(Fs_, fs_, r + m, n, 0.0)) return false;
+    if (!dual_.factorizeBlockDiagonal(Fs_, fs_, r + m, n, k, 0.0)) return false;
     const QpStatus s =
         dual_.solve(qp.C(), qp.lower(), qp.upper(), c, settings_.qp, prefer_.data(), from_ld);
     lr.iterations += dual_.iterations();

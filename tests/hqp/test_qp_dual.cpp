@@ -285,6 +285,58 @@ TEST(QpDual, DisjointRowsAreInfeasible) {
 
 // The method needs a positive definite Hessian: a rank-deficient A, or one whose smallest
 // singular value is below the requested margin, is refused.
+// factorizeBlockDiagonal on A = [A₁ 0; 0 D], b = [b₁; 0] (the dual start's stacked objective,
+// here with A₁ square or taller and D equal or varied): the unconstrained minimizer is
+// [argmin ‖A₁y − b₁‖; 0] (an independent QR), and every solve ends exactly as after
+// factorize() on the same stacked matrix (status, iterations, active rows, x bit for bit),
+// at a KKT point.
+TEST(QpDual, BlockDiagonalFactorizationIsTheStackedOne) {
+  std::mt19937 rng(2024);
+  std::uniform_int_distribution<int> Uk(1, 14), Um(1, 14), Ux(0, 4), Umi(8, 50);
+  std::uniform_real_distribution<double> Ud(1e-3, 2.0);
+  LargeQp stacked, block;
+  int with_active = 0, taller = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const int k = Uk(rng), m = Um(rng), rt = k + (trial % 3 == 0 ? 0 : Ux(rng));
+    const int n = k + m, r = rt + m, mi = std::min(60, Umi(rng));
+    auto p = hqp::testing::makeRandomQp(rng, n, r, 0, mi, -1, 0.5);
+    Eigen::MatrixXd A1 = Eigen::MatrixXd::Random(rt, k);
+    const Eigen::VectorXd b1 = Eigen::VectorXd::Random(rt);
+    p.A.setZero(r, n);
+    p.A.topLeftCorner(rt, k) = A1;
+    const double sd = 1e-4 * A1.norm();
+    for (int i = 0; i < m; ++i) p.A(rt + i, k + i) = trial % 2 == 0 ? sd : Ud(rng);
+    p.b.setZero(r);
+    p.b.head(rt) = b1;
+    taller += rt > k;
+    ASSERT_TRUE(stacked.factorize(p.A, p.b, r, n, 0.0)) << trial;
+    ASSERT_TRUE(block.factorizeBlockDiagonal(p.A, p.b, r, n, k, 0.0)) << trial;
+    const Eigen::VectorXd y = A1.colPivHouseholderQr().solve(b1);
+    const Eigen::VectorXd x0 = block.unconstrainedMinimizer();
+    EXPECT_LT((x0.head(k) - y).cwiseAbs().maxCoeff(), 1e-10 * (1.0 + y.cwiseAbs().maxCoeff()))
+        << trial;
+    EXPECT_TRUE((x0.tail(m).array() == 0.0).all()) << trial;
+    EXPECT_TRUE((x0.array() == stacked.unconstrainedMinimizer().array()).all()) << trial;
+    const hqp::QpStatus sa = stacked.solve(p.C, p.lower, p.upper, mi, hqp::QpSettings{});
+    const hqp::QpStatus sb = block.solve(p.C, p.lower, p.upper, mi, hqp::QpSettings{});
+    ASSERT_EQ(sa, sb) << trial;
+    ASSERT_EQ(sb, hqp::QpStatus::Optimal) << trial;
+    EXPECT_EQ(stacked.iterations(), block.iterations()) << trial;
+    ASSERT_EQ(stacked.numActive(), block.numActive()) << trial;
+    for (int a = 0; a < block.numActive(); ++a)
+      EXPECT_EQ(stacked.activeRow(a), block.activeRow(a)) << trial;
+    EXPECT_TRUE((stacked.x().array() == block.x().array()).all()) << trial;
+    EXPECT_LT(kktError(block, p), 1e-9) << trial;
+    with_active += block.numActive() > 0;
+  }
+  EXPECT_GT(with_active, 250);
+  EXPECT_GT(taller, 100);
+  Eigen::MatrixXd A = Eigen::MatrixXd::Identity(4, 3);
+  const Eigen::VectorXd b = Eigen::VectorXd::Ones(4);
+  EXPECT_FALSE(block.factorizeBlockDiagonal(A, b, 4, 3, 4, 0.0));  // k beyond n
+  EXPECT_FALSE(block.factorizeBlockDiagonal(A, b, 4, 3, -1, 0.0));
+}
+
 TEST(QpDual, RefusesObjectivesThatAreNotStrictlyConvex) {
   SmallQp qp;
   Eigen::MatrixXd A(4, 3);
