@@ -114,33 +114,49 @@ class DualActiveSetQp {
   // σ_min(A): the objective is then strictly convex by at least that margin.
   template <class MatA, class VecB>
   bool factorize(const MatA& A, const VecB& b, int r, int n, double min_sigma) noexcept {
-    return factorizeMapped(mapColumns(A), mapVector(b), r, n, min_sigma, n);
+    return factorizeMapped(mapColumns(A), mapVector(b), r, n, min_sigma);
   }
 
-  // factorize() for A = [A₁ 0; 0 D] and b = [b₁; 0], where A₁ is the first k columns of the
-  // top r − (n − k) rows and D is diagonal (n − k nonzero entries), as the dual start's
-  // stacked objective: every zero must be exact. The same R, J and minimizer as factorize()
-  // (its Householder steps on the zero blocks only move zeros; a zero's sign may differ), for
-  // the QR of A₁ alone and two-row steps on D's columns.
-  template <class MatA, class VecB>
-  bool factorizeBlockDiagonal(const MatA& A, const VecB& b, int r, int n, int k,
+  // factorize() for the block-diagonal objective A = [A₁ 0; 0 diag(d)], b = [b₁; 0], formed
+  // here from A₁ (the first k columns of A1's top rt rows), b₁ (b1's top rt entries) and d
+  // (n − k entries, n = k + d.size()): the dual start's stacked objective. The same R, J and
+  // minimizer as factorize() on that stacked matrix (its Householder steps on the zero blocks
+  // only move zeros; a zero's sign may differ), for the QR of A₁ alone and a two-row step on
+  // each column of diag(d). False (nothing valid) if k < 0, rt < k or A1, b1 are smaller than
+  // stated, besides factorize()'s own refusals.
+  template <class MatA, class VecB, class VecD>
+  bool factorizeBlockDiagonal(const MatA& A1, const VecB& b1, int rt, int k, const VecD& d,
                               double min_sigma) noexcept {
-    if (k < 0 || k > n) return false;
-    return factorizeMapped(mapColumns(A), mapVector(b), r, n, min_sigma, k);
+    const int m = static_cast<int>(d.size()), n = k + m, r = rt + m;
+    n_ = n;
+    factorized_ = false;
+    if (k < 0 || rt < k || A1.rows() < rt || A1.cols() < k || b1.size() < rt) return false;
+    if (n <= 0 || n > MaxN || r > MaxRows) return false;
+    F_.topLeftCorner(r, n).setZero();
+    F_.topLeftCorner(rt, k) = A1.topLeftCorner(rt, k);
+    for (int i = 0; i < m; ++i) F_(rt + i, k + i) = d(i);
+    c_.head(r).setZero();
+    c_.head(rt) = b1.head(rt);
+    return factorizeStored(r, n, min_sigma, k);
   }
 
  private:
   // factorize() on A and b as maps: the method's code is compiled once per solver type,
   // whatever block or matrix type the caller holds its data in (docs/hqp.md, "One copy of
   // the dual method's code").
-  // k < n: A = [A₁ 0; 0 D] as factorizeBlockDiagonal() states; rt = r − (n − k) rows of A₁.
   bool factorizeMapped(const ColumnsMap& A, const VectorMap& b, int r, int n,
-                       double min_sigma, int k) noexcept {
+                       double min_sigma) noexcept {
     n_ = n;
     factorized_ = false;
     if (n <= 0 || n > MaxN || r < n || r > MaxRows) return false;
     F_.topLeftCorner(r, n) = A.topLeftCorner(r, n);
     c_.head(r) = b.head(r);
+    return factorizeStored(r, n, min_sigma, n);
+  }
+
+  // The factorization of F_ (r x n) and c_ as stored. k < n: F_ = [A₁ 0; 0 D] as
+  // factorizeBlockDiagonal() forms it, rt = r − (n − k) rows of A₁.
+  bool factorizeStored(int r, int n, double min_sigma, int k) noexcept {
     const double anorm = F_.topLeftCorner(r, n).norm();
     if (!std::isfinite(anorm) || !c_.head(r).allFinite()) return false;
     min_sigma = std::max(min_sigma, kMinSigmaFloor * anorm);

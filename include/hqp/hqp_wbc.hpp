@@ -1280,15 +1280,12 @@ class HqpWbc {
       breaks = qp.lower()(i) > tol * sc || qp.upper()(i) < -tol * sc;
     }
     if (!breaks) return false;
-    const int m = n - k;
-    Fs_.setZero(r + m, n);
-    Fs_.topRows(r) = qp.A();  // Â Q with columns k.. zero (truncated to rank k)
+    // qp.A() = Â Q with columns k.. zero (truncated to rank k): its first k columns are Â Q₁.
     const double an = qp.A().norm();
     const double sd = 1e-4 * (an > 0.0 ? an : 1.0);
-    for (int i = 0; i < m; ++i) Fs_(r + i, k + i) = sd;
-    fs_.setZero(r + m);
-    fs_.head(r) = qp.b();
-    if (!dual_.factorizeBlockDiagonal(Fs_, fs_, r + m, n, k, 0.0)) return false;
+    using Diagonal = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, Nx, 1>;
+    if (!dual_.factorizeBlockDiagonal(qp.A(), qp.b(), r, k, Diagonal::Constant(n - k, sd), 0.0))
+      return false;
     const QpStatus s =
         dual_.solve(qp.C(), qp.lower(), qp.upper(), c, settings_.qp, prefer_.data(), from_ld);
     lr.iterations += dual_.iterations();
@@ -1479,9 +1476,7 @@ class HqpWbc {
   QpTuple qps_;
   SlackQp slack_qp_;
   DualQp dual_;
-  // The dual start's objective [Â Q; 0 √δ I] and b̂, and its working set.
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, Nx + capacity(max_task_rows), Nx> Fs_;
-  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, Nx + capacity(max_task_rows), 1> fs_;
+  // The dual start's working set.
   std::array<int, max_active> start_row_{};
   std::array<bool, max_active> start_upper_{};
   VectorC dlo_ = VectorC::Zero(), dup_ = VectorC::Zero();  // its bounds

@@ -283,10 +283,9 @@ TEST(QpDual, DisjointRowsAreInfeasible) {
   EXPECT_NEAR(qp.x()(1), 0.0, 1e-12);
 }
 
-// The method needs a positive definite Hessian: a rank-deficient A, or one whose smallest
-// singular value is below the requested margin, is refused.
-// factorizeBlockDiagonal on A = [A₁ 0; 0 D], b = [b₁; 0] (the dual start's stacked objective,
-// here with A₁ square or taller and D equal or varied): the unconstrained minimizer is
+// factorizeBlockDiagonal from A₁, b₁ and D's diagonal against factorize() on the stacked
+// A = [A₁ 0; 0 D], b = [b₁; 0] (the dual start's objective, here with A₁ square or taller, D
+// equal or varied, and A₁ given as the top-left block of a larger matrix): the unconstrained minimizer is
 // [argmin ‖A₁y − b₁‖; 0] (an independent QR), and every solve ends exactly as after
 // factorize() on the same stacked matrix (status, iterations, active rows, x bit for bit),
 // at a KKT point.
@@ -302,15 +301,22 @@ TEST(QpDual, BlockDiagonalFactorizationIsTheStackedOne) {
     auto p = hqp::testing::makeRandomQp(rng, n, r, 0, mi, -1, 0.5);
     Eigen::MatrixXd A1 = Eigen::MatrixXd::Random(rt, k);
     const Eigen::VectorXd b1 = Eigen::VectorXd::Random(rt);
+    const double sd = 1e-4 * A1.norm();
+    Eigen::VectorXd d(m);
+    for (int i = 0; i < m; ++i) d(i) = trial % 2 == 0 ? sd : Ud(rng);
     p.A.setZero(r, n);
     p.A.topLeftCorner(rt, k) = A1;
-    const double sd = 1e-4 * A1.norm();
-    for (int i = 0; i < m; ++i) p.A(rt + i, k + i) = trial % 2 == 0 ? sd : Ud(rng);
+    p.A.bottomRightCorner(m, m) = d.asDiagonal();
     p.b.setZero(r);
     p.b.head(rt) = b1;
     taller += rt > k;
+    // A₁ and b₁ inside larger arrays whose other entries must not be read.
+    Eigen::MatrixXd A1big = Eigen::MatrixXd::Constant(rt + 2, n, 7.0);
+    A1big.topLeftCorner(rt, k) = A1;
+    Eigen::VectorXd b1big = Eigen::VectorXd::Constant(rt + 2, 7.0);
+    b1big.head(rt) = b1;
     ASSERT_TRUE(stacked.factorize(p.A, p.b, r, n, 0.0)) << trial;
-    ASSERT_TRUE(block.factorizeBlockDiagonal(p.A, p.b, r, n, k, 0.0)) << trial;
+    ASSERT_TRUE(block.factorizeBlockDiagonal(A1big, b1big, rt, k, d, 0.0)) << trial;
     const Eigen::VectorXd y = A1.colPivHouseholderQr().solve(b1);
     const Eigen::VectorXd x0 = block.unconstrainedMinimizer();
     EXPECT_LT((x0.head(k) - y).cwiseAbs().maxCoeff(), 1e-10 * (1.0 + y.cwiseAbs().maxCoeff()))
@@ -332,11 +338,15 @@ TEST(QpDual, BlockDiagonalFactorizationIsTheStackedOne) {
   EXPECT_GT(with_active, 250);
   EXPECT_GT(taller, 100);
   Eigen::MatrixXd A = Eigen::MatrixXd::Identity(4, 3);
-  const Eigen::VectorXd b = Eigen::VectorXd::Ones(4);
-  EXPECT_FALSE(block.factorizeBlockDiagonal(A, b, 4, 3, 4, 0.0));  // k beyond n
-  EXPECT_FALSE(block.factorizeBlockDiagonal(A, b, 4, 3, -1, 0.0));
+  const Eigen::VectorXd b = Eigen::VectorXd::Ones(4), d = Eigen::VectorXd::Ones(2);
+  EXPECT_FALSE(block.factorizeBlockDiagonal(A, b, 2, 3, d, 0.0));   // rt < k: A₁ not tall
+  EXPECT_FALSE(block.factorizeBlockDiagonal(A, b, 4, -1, d, 0.0));  // k < 0
+  EXPECT_FALSE(block.factorizeBlockDiagonal(A, b, 5, 3, d, 0.0));   // A₁ beyond A's rows
+  EXPECT_TRUE(block.factorizeBlockDiagonal(A, b, 4, 3, d, 0.0));
 }
 
+// The method needs a positive definite Hessian: a rank-deficient A, or one whose smallest
+// singular value is below the requested margin, is refused.
 TEST(QpDual, RefusesObjectivesThatAreNotStrictlyConvex) {
   SmallQp qp;
   Eigen::MatrixXd A(4, 3);
