@@ -13,7 +13,7 @@ start=$(date +%s)
 # main build stops them with their compilers. Where Linux's autogroup scheduler is on (as on the
 # machines this project is built on), each session gets an equal share of the CPU and nice acts
 # only within it: the side jobs build and run during the main build and are done before ctest
-# ends. Side jobs on idle time only (one session, nice 19) were measured slower: their builds
+# ends. Side jobs on idle time only (one session, nice 19) gave no shorter run: their builds
 # waited for ctest's end (docs/development.md, "Build and CI cost"). Logs are printed at the end.
 logs=$(mktemp -d)
 setsid nice -n 19 bash "$root/scripts/sanitize.sh" >"$logs/asan.txt" 2>&1 &
