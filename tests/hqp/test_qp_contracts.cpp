@@ -20,6 +20,12 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 std::string str(hqp::QpStatus s) { return hqp::toString(s); }
 
+// Three solver shapes for the whole file, the problems sized at run time within them: each
+// distinct shape is a whole instantiation of its solver, most of this unit's compile time
+// (docs/development.md, "Build and CI cost").
+using SmallQp = hqp::ActiveSetQp<4, 7, 3, 8>;
+using SmallDual = hqp::DualActiveSetQp<8, 12, 10>;
+
 // Largest violation of lower ≤ C x ≤ upper, rows scaled to unit norm; with rel > 0, each row's
 // violation is counted only beyond rel · |ĉ x| (rounding of a large row value).
 double violation(const Eigen::MatrixXd& C, const Eigen::VectorXd& lo, const Eigen::VectorXd& up,
@@ -42,11 +48,10 @@ double violation(const Eigen::MatrixXd& C, const Eigen::VectorXd& lo, const Eige
 
 // A problem with a feasible point (checked by the caller): ActiveSetQp must not call it
 // Infeasible, and an Optimal answer meets every row (rounding of large row values aside).
-// min ½‖A x − b‖² s.t. lo ≤ C x ≤ up (no equality rows) loaded into an ActiveSetQp of full size.
-template <int N, int M, int I>
-void load(hqp::ActiveSetQp<N, M, 0, I>& qp, const Eigen::MatrixXd& A, const Eigen::VectorXd& b,
-          const Eigen::MatrixXd& C, const Eigen::VectorXd& lo, const Eigen::VectorXd& up) {
-  qp.resize(N, M, 0, I);
+// min ½‖A x − b‖² s.t. lo ≤ C x ≤ up (no equality rows) loaded into an ActiveSetQp.
+void load(SmallQp& qp, const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const Eigen::MatrixXd& C,
+          const Eigen::VectorXd& lo, const Eigen::VectorXd& up) {
+  qp.resize(static_cast<int>(A.cols()), static_cast<int>(A.rows()), 0, static_cast<int>(C.rows()));
   qp.A() = A;
   qp.b() = b;
   qp.C() = C;
@@ -54,11 +59,9 @@ void load(hqp::ActiveSetQp<N, M, 0, I>& qp, const Eigen::MatrixXd& A, const Eige
   qp.upper() = up;
 }
 
-template <int N, int M, int E, int I>
 void expectNotInfeasible(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const Eigen::MatrixXd& C,
                          const Eigen::VectorXd& lo, const Eigen::VectorXd& up) {
-  static_assert(E == 0, "the problems have no equality rows");
-  hqp::ActiveSetQp<N, M, E, I> qp;
+  SmallQp qp;
   load(qp, A, b, C, lo, up);
   const hqp::QpStatus s = qp.solve(false);
   EXPECT_NE(s, hqp::QpStatus::Infeasible);
@@ -67,11 +70,9 @@ void expectNotInfeasible(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, con
   }
 }
 
-using Dual2 = hqp::DualActiveSetQp<2, 2, 2>;
-
 // min ½‖x‖² s.t. 1 ≤ x₀ ≤ 0: no feasible point (was: Optimal with x₀ = 1).
 TEST(QpContracts, DualCrossedBoundsAreInfeasible) {
-  Dual2 qp;
+  SmallDual qp;
   const Eigen::Matrix2d A = Eigen::Matrix2d::Identity();
   const Eigen::Vector2d b(0.0, 0.0);
   ASSERT_TRUE(qp.factorize(A, b, 2, 2, 0.0));
@@ -90,7 +91,7 @@ TEST(QpContracts, DualCrossedBoundsAreInfeasible) {
 
 // NaN in C or in a bound: refused (was: Optimal).
 TEST(QpContracts, DualRefusesNaNAndWrongSideInfinities) {
-  Dual2 qp;
+  SmallDual qp;
   const Eigen::Matrix2d A = Eigen::Matrix2d::Identity();
   const Eigen::Vector2d b(3.0, -1.0);
   ASSERT_TRUE(qp.factorize(A, b, 2, 2, 0.0));
@@ -129,11 +130,9 @@ TEST(QpContracts, DualRefusesNaNAndWrongSideInfinities) {
   EXPECT_EQ(str(qp.solve(C, lo, up, 2, hqp::QpSettings{})), "InvalidInput");
 }
 
-using Qp3 = hqp::ActiveSetQp<3, 3, 0, 2>;
-
 // A row [+inf, +inf] was ignored (Optimal); [−inf, −inf] gave NumericalFailure.
 TEST(QpContracts, ActiveSetRefusesWrongSideInfinities) {
-  Qp3 qp;
+  SmallQp qp;
   qp.resize(3, 3, 0, 2);
   qp.A().setIdentity();
   qp.b() << 1.0, 2.0, 3.0;
@@ -193,7 +192,7 @@ TEST(QpContracts, DualNearlySingularNeverWrong) {
       if (U01(g) < 0.5) lo(j) = -kInf;
       else up(j) = kInf;
     }
-    hqp::DualActiveSetQp<8, 12, 10> qp;
+    SmallDual qp;
     if (!qp.factorize(A, b, r, n, 0.0)) {
       ++refused;
       continue;
@@ -449,7 +448,7 @@ TEST(QpContracts, DualNeverInfeasibleWithDependentFeasibleRows) {
   // (10.375, 10.375) for the second (10.375 · 10.375 = 107.640625, twice that 215.28125).
   const Eigen::VectorXd points[] = {Eigen::VectorXd::Zero(2), Eigen::VectorXd::Constant(2, 10.375),
                                     Eigen::VectorXd::Zero(5)};
-  hqp::DualActiveSetQp<6, 9, 8> qp;
+  SmallDual qp;
   for (int i = 0; i < 3; ++i) {
     const RowProblem& p = problems[i];
     ASSERT_EQ(violation(p.C, p.lower, p.upper, points[i]), 0.0) << i;
@@ -471,7 +470,7 @@ TEST(QpContracts, DualDependentContradictingRowsAreInfeasible) {
   Eigen::VectorXd b = Eigen::VectorXd::Zero(2), lo(3), up(3);
   lo << 1, 1, -kInf;
   up << kInf, kInf, 1;
-  hqp::DualActiveSetQp<2, 2, 3> qp;
+  SmallDual qp;
   ASSERT_TRUE(qp.factorize(A, b, 2, 2, 1e-9));
   EXPECT_EQ(str(qp.solve(C, lo, up, 3, hqp::QpSettings{})), "Infeasible");
   up(2) = 2.0;  // now x = (1, 1) meets all three
@@ -501,7 +500,7 @@ TEST(QpContracts, ActiveSetNeverInfeasibleWhenFeasibleToTheTolerance) {
   K << C.row(3), C.row(1);
   const Eigen::Vector2d xt = K.fullPivLu().solve(Eigen::Vector2d(lo(3), lo(1)));
   ASSERT_LE(violation(C, lo, up, xt), 1e-9);
-  expectNotInfeasible<2, 7, 0, 8>(A, b, C, lo, up);
+  expectNotInfeasible(A, b, C, lo, up);
 }
 
 // active_set_qp_objective_below_enumeration: C does not see the direction (0, 1, −1, 0) and A
@@ -517,7 +516,7 @@ TEST(QpContracts, ActiveSetMatchesEnumerationWithTheOptimumFarOut) {
   Eigen::VectorXd b = Eigen::VectorXd::Constant(3, -11.25), lo(5), up(5);
   lo << 143.08216171267756, 187.80091171267756, 164.80091171267756, 187.80091171267756, 187.80091171267756;
   up << kInf, 219.80091171267756, 196.80091171267756, 219.80091171267756, 219.80091171267756;
-  hqp::ActiveSetQp<4, 3, 0, 5> qp;
+  SmallQp qp;
   load(qp, A, b, C, lo, up);
   ASSERT_EQ(str(qp.solve(false)), "Optimal");
   EXPECT_LE(violation(C, lo, up, qp.x(), 1e-9), 1e-9);
@@ -538,10 +537,10 @@ TEST(QpContracts, DualAndPrimalAgreeUpToTheToleranceOnNearlyParallelRows) {
       3.2549019607842844, 3.2549019607843128, -9.9997977493330801, -16, -16, -16, -16, -16, -16;
   const Eigen::VectorXd b = Eigen::VectorXd::Constant(3, -16.0), lo = Eigen::VectorXd::Constant(7, -32.0),
                         up = Eigen::VectorXd::Zero(7);
-  hqp::DualActiveSetQp<2, 3, 7> dual;
+  SmallDual dual;
   ASSERT_TRUE(dual.factorize(A, b, 3, 2, 1e-9));
   const hqp::QpStatus sd = dual.solve(C, lo, up, 7, hqp::QpSettings{});
-  hqp::ActiveSetQp<2, 3, 0, 7> primal;
+  SmallQp primal;
   load(primal, A, b, C, lo, up);
   ASSERT_EQ(str(primal.solve(false)), "Optimal");
   ASSERT_EQ(str(sd), "Optimal");
@@ -590,7 +589,7 @@ TEST(QpContracts, ActiveSetNeverInfeasibleWithAFeasiblePointFarOut) {
   xw(2) = (-16.0 - C(3, 3) * xw(3)) / C(3, 2);
   ASSERT_GT(xw.cwiseAbs().maxCoeff(), 1e9);
   ASSERT_LE(violation(C, lo, up, xw, 1e-9), 1e-9);
-  expectNotInfeasible<4, 6, 0, 5>(A, b, C, lo, up);
+  expectNotInfeasible(A, b, C, lo, up);
 }
 
 // dual_qp_optimal_active_row_off_bound: rows 0 and 2 at an angle of 1e-11, both active, blew
@@ -610,7 +609,7 @@ TEST(QpContracts, DualOptimalHoldsItsActiveRowsAtTheirBounds) {
       0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 11.875, 0, -9.839966288745286e-05;
   lo << 0, 70.091371920222585, -32, -32, -32, -32, -32, -32;
   up << 6.1941349662762075, kInf, 0, 0, 0, 0, 0, 0;
-  hqp::DualActiveSetQp<5, 5, 8> qp;
+  SmallDual qp;
   ASSERT_TRUE(qp.factorize(A, b, 5, 5, 1e-9));
   const hqp::QpStatus s = qp.solve(C, lo, up, 8, hqp::QpSettings{});
   if (s != hqp::QpStatus::Optimal) return;  // NumericalFailure is the honest answer here
@@ -636,7 +635,7 @@ TEST(QpContracts, ActiveSetNeverInfeasibleWithNearlyDependentEqualities) {
       7333.3333300459371;
   const Eigen::Vector2d xw(-16.0 / 7.3333333333333339, 0.0);
   for (int i = 0; i < 3; ++i) ASSERT_LE(std::abs(E.row(i).dot(xw) - e(i)) / E.row(i).norm(), 1e-15) << i;
-  hqp::ActiveSetQp<2, 4, 3, 1> qp;
+  SmallQp qp;
   qp.resize(2, 4, 3, 0);
   qp.A() = A;
   qp.b() = b;
