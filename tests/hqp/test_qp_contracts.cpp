@@ -20,9 +20,9 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 std::string str(hqp::QpStatus s) { return hqp::toString(s); }
 
-// Three solver shapes for the whole file, the problems sized at run time within them: each
-// distinct shape is a whole instantiation of its solver, most of this unit's compile time
-// (docs/development.md, "Build and CI cost").
+// Three solver shapes for the whole file (these two and Qp28 below), the problems sized at run
+// time within them: each distinct shape is a whole instantiation of its solver, most of this
+// unit's compile time (docs/development.md, "Build and CI cost").
 using SmallQp = hqp::ActiveSetQp<4, 7, 3, 8>;
 using SmallDual = hqp::DualActiveSetQp<8, 12, 10>;
 
