@@ -29,6 +29,7 @@
 #include "hqp/active_set_qp.hpp"
 #include "hqp/constraint.hpp"
 #include "hqp/dual_active_set_qp.hpp"
+#include "hqp/hierarchy_qps.hpp"
 #include "hqp/hqp_types.hpp"
 #include "hqp/level.hpp"
 #include "hqp/null_space.hpp"
@@ -166,18 +167,6 @@ struct HqpResult {
 
 namespace detail {
 
-// Stands in for a QP object where a level has no constraint at all.
-struct NoQp {
-  NoQp() = default;
-  explicit NoQp(const QpSettings&) {}
-};
-
-template <class... Levels>
-constexpr int maxTaskRows() {
-  int m = 0;
-  ((m = std::max(m, Levels::task_rows)), ...);
-  return m;
-}
 template <class... Levels>
 constexpr int maxConstraintRows() {
   int m = 0;
@@ -218,11 +207,12 @@ class HqpWbc {
   using Result = HqpResult<Nx, num_levels, max_active>;
   template <int P>
   using LevelType = std::tuple_element_t<P, std::tuple<Levels...>>;
-  // One QP object per level (each keeps its own warm start), all of one type sized for the
-  // largest level: Nx variables, the most task rows of any level, all constraint rows. One
-  // type instead of one per level keeps compile times down (each ActiveSetQp instantiation
-  // costs ~15 s of compiler time); the storage difference is a few kB per level.
-  using Qp = ActiveSetQp<Nx, capacity(max_task_rows), 0, capacity(total_constraint_rows)>;
+  // One QP object per level (each keeps its own warm start), all of one type: Nx variables,
+  // all constraint rows, and (WqpWbc's type, hierarchy_qps.hpp) room for every task row. One
+  // type instead of one per level, and the same as WqpWbc's, keeps compile times down (each
+  // ActiveSetQp instantiation costs ~15 s of compiler time); the storage difference is a few
+  // kB per level.
+  using Qp = typename detail::HierarchyQps<Nx, Levels...>::Qp;
   template <int P>
   using LevelQp = std::conditional_t<(constraint_offset[P + 1] > 0), Qp, detail::NoQp>;
   // Slack levels (Level<..., true>): minimal violation of one level's own rows, variables
@@ -234,13 +224,12 @@ class HqpWbc {
   // and hand nothing on but rows copied out: the last level (HqpSettings::dual_last_level,
   // at most Nx variables and its task rows), the least-distance step (least_distance_step,
   // a level's null-space part) and the dual start (dual_start, a level's variables, its task
-  // rows plus one per null-space variable). One type sized for the largest use: the method's
-  // code is compiled once (docs/hqp.md, "One copy of the dual method's code").
+  // rows plus one per null-space variable). One type sized for the largest use, WqpWbc's
+  // too: the method's code is compiled once (docs/hqp.md, "One copy of the dual method's code").
   static constexpr int last_task_rows = LevelType<sizeof...(Levels) - 1>::task_rows;
   using DualQp = std::conditional_t<
       (total_constraint_rows > 0 && (last_task_rows > 0 || sizeof...(Levels) > 2)),
-      DualActiveSetQp<Nx, Nx + capacity(max_task_rows), capacity(total_constraint_rows)>,
-      detail::NoQp>;
+      typename detail::HierarchyQps<Nx, Levels...>::DualQp, detail::NoQp>;
   using SlackQp = std::conditional_t<
       has_slack_levels,
       ActiveSetQp<Nx + capacity(max_slack_rows), capacity(max_slack_rows), 0,

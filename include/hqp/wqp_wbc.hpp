@@ -19,6 +19,7 @@
 #include "hqp/active_set_qp.hpp"
 #include "hqp/constraint.hpp"
 #include "hqp/dual_active_set_qp.hpp"
+#include "hqp/hierarchy_qps.hpp"
 #include "hqp/hqp_types.hpp"
 #include "hqp/level.hpp"
 #include "hqp/task.hpp"
@@ -56,10 +57,11 @@ class WqpWbc {
 
   using VectorX = Eigen::Matrix<double, Nx, 1>;
   using Result = WqpResult<Nx, num_levels, max_active>;
-  using Qp = ActiveSetQp<Nx, capacity(total_task_rows), 0, capacity(total_constraint_rows)>;
+  // HqpWbc's types for the same levels (hierarchy_qps.hpp).
+  using Qp = typename detail::HierarchyQps<Nx, Levels...>::Qp;
   // Stacked weighted rows of full column rank make the QP strictly convex: the dual method.
   using DualQp = std::conditional_t<(total_task_rows >= Nx && total_constraint_rows > 0),
-                                    DualActiveSetQp<Nx, total_task_rows, total_constraint_rows>,
+                                    typename detail::HierarchyQps<Nx, Levels...>::DualQp,
                                     detail::NoQp>;
   template <int P>
   using LevelType = std::tuple_element_t<P, std::tuple<Levels...>>;
