@@ -210,8 +210,8 @@ class HqpWbc {
   // One QP object per level (each keeps its own warm start), all of one type: Nx variables,
   // all constraint rows, and (WqpWbc's type, hierarchy_qps.hpp) room for every task row. One
   // type instead of one per level, and the same as WqpWbc's, keeps compile times down (each
-  // ActiveSetQp instantiation costs ~15 s of compiler time); the storage difference is a few
-  // kB per level.
+  // ActiveSetQp instantiation costs ~15 s of compiler time); the price is storage: on Table
+  // I's hierarchy 27 kB per level QP more than sized for the largest level (docs/hqp.md).
   using Qp = typename detail::HierarchyQps<Nx, Levels...>::Qp;
   template <int P>
   using LevelQp = std::conditional_t<(constraint_offset[P + 1] > 0), Qp, detail::NoQp>;
