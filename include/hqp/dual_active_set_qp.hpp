@@ -132,8 +132,10 @@ class DualActiveSetQp {
     factorized_ = false;
     if (k < 0 || rt < k || A1.rows() < rt || A1.cols() < k || b1.size() < rt) return false;
     if (n <= 0 || n > MaxN || r > MaxRows) return false;
-    F_.topLeftCorner(r, n).setZero();
+    // F_ = [A₁ 0; 0 D], each entry written once (A₁ is rt x k, D is m x m diagonal).
     F_.topLeftCorner(rt, k) = A1.topLeftCorner(rt, k);
+    F_.block(0, k, rt, m).setZero();
+    F_.block(rt, 0, m, n).setZero();
     for (int i = 0; i < m; ++i) F_(rt + i, k + i) = d(i);
     c_.head(r).setZero();
     c_.head(rt) = b1.head(rt);
