@@ -34,7 +34,7 @@ Config loadConfig(const std::string& path);
 
 class FirmwareController {
  public:
-  // Set-up time: allocates the controller (947 KiB, docs/controller.md) once.
+  // Set-up time: allocates the controller (about 1 MB, docs/controller.md) once.
   explicit FirmwareController(const Config& config);
   ~FirmwareController();
   FirmwareController(const FirmwareController&) = delete;

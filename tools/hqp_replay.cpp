@@ -108,7 +108,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "hqp_replay: no instance %ld (the file has %zu)\n", instance, instances.size());
     return 2;
   }
-  auto wbc = std::make_unique<Replay>(info.settings);  // 664 KiB (docs/hqp.md): not on the stack
+  auto wbc = std::make_unique<Replay>(info.settings);  // hundreds of KiB (docs/hqp.md): not on the stack
   if (instance >= 0) {
     const Instance& in = instances[static_cast<std::size_t>(instance)];
     const Outcome o = replay(*wbc, in, cold);

@@ -103,7 +103,7 @@ void BM_Corpus(benchmark::State& state, const char* name, bool warm) {
   }
   const auto& v = fam.instances;
   const std::size_t n = v.size();
-  auto wbc = std::make_unique<Wbc>(fam.info.shippedSettings());  // 664 KiB (docs/hqp.md): not on the stack
+  auto wbc = std::make_unique<Wbc>(fam.info.shippedSettings());  // hundreds of KiB (docs/hqp.md): not on the stack
   auto peer = std::make_unique<Peer>();
   std::vector<std::vector<double>> th(n), tp(n);
   std::vector<double> pooled_h, pooled_p;

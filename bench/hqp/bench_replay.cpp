@@ -92,7 +92,7 @@ void BM_HqpReplay(benchmark::State& state) {
   const bool warm = state.range(0) != 0;
   const auto& v = rec.instances;
   const std::size_t n = v.size();
-  static std::unique_ptr<Replay> wbc;  // 664 KiB (docs/hqp.md): not on the stack
+  static std::unique_ptr<Replay> wbc;  // hundreds of KiB (docs/hqp.md): not on the stack
   if (!wbc) wbc = std::make_unique<Replay>(rec.info.shippedSettings());
   // Solve times, pooled (every replayed solve) and per instance; L levels + the whole solve.
   std::array<std::vector<double>, L + 1> pooled;

@@ -22,7 +22,7 @@ inline Walker3Controller::Config walker3Config(Walker3Controller::Config::Solver
   return cfg;
 }
 
-// On the heap: the controller holds both solvers (947 KiB, docs/controller.md).
+// On the heap: the controller holds both solvers (about 1 MB, docs/controller.md).
 inline std::unique_ptr<Walker3Controller> makeWalker3Controller(const Walker3Controller::Config& cfg) {
   using R = walker3::Robot;
   return std::make_unique<Walker3Controller>(

@@ -53,7 +53,8 @@ int main(int argc, char** argv) {
 
   auto config = hqp::tasks::loadControllerConfig<Robot>(argv[1]);
   config.planner.com_height = dyn.com().z();   // the planner's C for this pose
-  // On the heap, once: the controller holds both solvers (947 KiB); its tick never allocates.
+  // On the heap, once: the controller holds both solvers (about 1 MB, docs/controller.md);
+  // its tick never allocates.
   auto ctrl = std::make_unique<Controller>(config, std::array<int, 2>{F::l_sole, F::r_sole},
                                            std::array<int, 2>{F::l_ft_sensor, F::r_ft_sensor}, F::imu);
   Controller::Command command;
