@@ -335,7 +335,7 @@ def fig8(run, out, title, pushes, fall_time):
         not_logged(ax, "torso pitch (torso_pitch)")
     else:
         if tp is not None:
-            plot_angle(ax, t, tp * deg, "tab:orange", "torso pitch", "max |pitch| {:.1f}° at {:.2f} s")
+            plot_angle(ax, t, tp * deg, "tab:orange", "torso pitch", "max |pitch| {:.2f}° at {:.2f} s")
         if tr is not None:
             plot_line(ax, t, tr * deg, color="tab:brown", lw=0.7, ls="--", alpha=0.8, label="torso roll")
             m = finite_extreme(t, tr * deg, "abs")
