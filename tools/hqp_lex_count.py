@@ -188,13 +188,14 @@ def main():
         capped = " capped" if r.get("capped") else ""
         print(f"{k} {kind} adds {r['adds']} drops {r['drops']} active {r['active']} {verdict}{capped}")
         sys.stdout.flush()
-        stats.setdefault(kind, []).append((r["adds"] + r["drops"], verdict))
+        stats.setdefault(kind, []).append((r["adds"] + r["drops"], verdict, bool(capped)))
     for kind, v in sorted(stats.items()):
-        c = np.array([x for x, _ in v])
-        same = sum(1 for _, s in v if s == "same")
-        print(f"{kind}: {len(v)} instances, working-set changes mean {c.mean():.1f} median "
-              f"{np.median(c):.0f} p90 {np.percentile(c, 90):.0f} max {c.max()}; "
-              f"stored objectives reached on {same}")
+        ended = [(x, s) for x, s, cap in v if not cap]
+        c = np.array([x for x, _ in ended])
+        same = sum(1 for _, s in ended if s == "same")
+        print(f"{kind}: {len(v)} instances, {len(v) - len(ended)} cycling (capped); the others: "
+              f"working-set changes mean {c.mean():.1f} median {np.median(c):.0f} p90 "
+              f"{np.percentile(c, 90):.0f} max {c.max()}, stored objectives reached on {same}")
 
 
 if __name__ == "__main__":
