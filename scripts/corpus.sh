@@ -14,10 +14,10 @@
 #       another copy of the corpus (below), NEW_CORPUS_DIR=DIR the new one (e.g. steady).
 #   bash scripts/corpus.sh steady DIR   # the families into DIR with each instance warm-started
 #       from the working sets its own solve ends with (a controller's next tick on an unchanged
-#       problem; docs/benchmarks.md, "The steady state")
+#       problem; docs/hqp-tuning.md, "The steady state")
 #   bash scripts/corpus.sh reformulate DIR [SEED]  # the families into DIR written as another
 #       formulation of the same hierarchies: variables permuted, rows rescaled (same optima up
-#       to the permutation, other rounding; docs/benchmarks.md, "Reformulated corpus"). Then
+#       to the permutation, other rounding; docs/hqp-tuning.md, "Reformulated corpus"). Then
 #       `hqp_corpus check DIR`, or compare with NEW_CORPUS_DIR=DIR (OLD_CORPUS_DIR: its v2 copy)
 #   bash scripts/corpus.sh v2 DIR [SRC]  # the corpus (or the files in SRC) as format version 2
 #       into DIR, for a bench_hqp from before version 3 (e.g. 3c579bd, before the deferred

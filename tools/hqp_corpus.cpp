@@ -545,7 +545,7 @@ int rewriteFamilies(const std::string& dir, const std::string& out_dir, const st
 
 // Every instance's warm start replaced by the working sets this build's solve of it ends with
 // (from its recorded warm start): a controller's next tick on a problem that did not change
-// (docs/benchmarks.md, "The steady state"). Instances, stored results and header as read.
+// (docs/hqp-tuning.md, "The steady state"). Instances, stored results and header as read.
 int steadyCommand(const std::string& dir, const std::string& out_dir) {
   return rewriteFamilies(dir, out_dir, "warm starts: the working sets each solve ends with",
                          [](const hqp::ProblemFileInfo& info, std::size_t, std::vector<Instance>& v) {
@@ -560,7 +560,7 @@ int steadyCommand(const std::string& dir, const std::string& out_dir) {
 
 // ---- Reformulations -------------------------------------------------------------------------
 
-// The same hierarchy written another way (docs/benchmarks.md, "Reformulated corpus"):
+// The same hierarchy written another way (docs/hqp-tuning.md, "Reformulated corpus"):
 //  - the variables in a random order: A and D by columns, the stored x* by rows;
 //  - every constraint row times f ∈ [1/2, 2] (D_i and both bounds; ±inf stays), its stored
 //    multiplier divided by f;

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""How many working-set changes a method over all levels at once would take (docs/benchmarks.md,
+"""How many working-set changes a method over all levels at once would take (docs/hqp-tuning.md,
 "What a method over all levels at once would start from").
 
 A primal active-set method on the whole lexicographic problem: every constraint row hard from the

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Independent optimum of every level of HqpWbc's solutions (docs/benchmarks.md, "The last level
+"""Independent optimum of every level of HqpWbc's solutions (docs/hqp-tuning.md, "The last level
 on nearly dependent rows").
 
 Reads the JSON of `hqp_corpus dump FILE OUT.json` (rows, bounds, the warm solve's x). For each

@@ -713,7 +713,7 @@ bool ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::nearlyDependent(double zeta, do
   // The caller skips such a row only where that is harmless (harmlessCut()), as an exactly
   // dependent one is: treated as held by K, like Goldfarb & Idnani's constraint whose normal
   // is in the span of the active ones. Refusing it where it is not harmless was measured to
-  // break feasibility of other QPs (docs/benchmarks.md, "Exactness").
+  // break feasibility of other QPs (docs/hqp-tuning.md, "The corpus's first check").
   constexpr double kSqrtEps = 1.4901161193847656e-08;
   if (zeta <= kSqrtEps) return true;  // δ ≤ ζ
   for (int i = k_ - 1; i >= 0; --i) {  // β = R⁻¹ w(0:k) into p_ (scratch until subproblem())

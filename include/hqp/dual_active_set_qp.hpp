@@ -339,7 +339,7 @@ class DualActiveSetQp {
         // that span is at most √ε of it: a step along so small a z adds a row nearly dependent
         // on the active ones, whose multipliers (~1/σ_min) are then noise. A bound of 1e-12
         // instead of √ε let multipliers of 1e16 through, and an "Optimal" 4.9 times above
-        // the optimum on a stress instance (docs/benchmarks.md, "The last level on nearly
+        // the optimum on a stress instance (docs/hqp-tuning.md, "The last level on nearly
         // dependent rows").
         constexpr double kDependent = std::numeric_limits<double>::epsilon();
         const bool primal = dz2 > kDependent * d_.head(n).squaredNorm() && dz2 > 0.0;

@@ -910,7 +910,7 @@ class HqpWbc {
     // rows: where it is the optimum's own nearly dependent vertex (a controller's next tick on
     // an unchanged problem) the union ended NumericalFailure on 6 stress instances (203, 242:
     // ~150 µs through the order-free route), the level above's rows alone on 3
-    // (docs/benchmarks.md, "The steady state"); on the recorded stress family the two take
+    // (docs/hqp-tuning.md, "The steady state"); on the recorded stress family the two take
     // 14.00 and 13.93 iterations.
     const auto& above = result_.levels[P > 0 ? P - 1 : 0];
     int own = 0;
@@ -971,7 +971,7 @@ class HqpWbc {
     // cascade a failed first order goes to routes that depend on no order
     // (DualActiveSetQp::solveOrderFree), before the general path's ActiveSetQp, which can end
     // on such rows too: there another order met the same rows on every stress instance seen
-    // (docs/benchmarks.md, "The stress tail by phase").
+    // (docs/hqp-tuning.md, "The stress tail by phase").
     QpStatus s = dual_.solve(Cw, dlo_, dup_, c, settings_.qp, prefer_.data(), own);
     if (s == QpStatus::NumericalFailure && own > 0 && deferred_ &&
         dual_.factorize(M_, bq_, r, n, min_sigma))

@@ -64,19 +64,29 @@ TEST(Recording, CheckedInFileHasRealInstances) {
   hqp::ProblemFileInfo info;
   const auto& v = recorded(&info);
   ASSERT_GE(v.size(), 50u) << info.source;
-  // Real, not trivial, instances: torque or contact rows active on some ticks, level 4 (the
-  // compromise) with a non-zero residual, and at least one tick on which a working set changed
-  // (a level's QP iterated from its warm start), so the warm replay below follows a path.
-  int with_active = 0, iterated = 0;
+  // Real, not trivial, instances: torque, CoP or friction rows active on some ticks (on the
+  // deferred path every constraint row sits at the last level), ticks that start from such rows
+  // (the warm replay below has a working set to start from), level 4 (the compromise) with a
+  // non-zero residual, and at least one tick on which a working set changed (a level's QP
+  // iterated), so the warm replay below follows a path.
+  int with_active = 0, warm_started = 0, iterated = 0;
   for (const auto& in : v) {
-    if (in.result.levels[0].num_active + in.result.levels[1].num_active > 0) ++with_active;
+    int active = 0, incoming = 0, it = 0;
+    for (const auto& l : in.result.levels) {
+      active += l.num_active;
+      it += l.iterations;
+    }
+    for (const auto& w : in.warm) incoming += w.num_active;
+    with_active += active > 0;
+    warm_started += incoming > 0;
+    iterated += it > 0;
     EXPECT_GT(in.result.levels[3].residual, 0.0);
-    int it = 0;
-    for (const auto& l : in.result.levels) it += l.iterations;
-    if (it > 0) ++iterated;
   }
   EXPECT_GT(with_active, 0);
+  EXPECT_GT(warm_started, 0);
   EXPECT_GT(iterated, 0);
+  std::printf("%d of %zu ticks with active rows, %d started from some, %d iterated\n", with_active,
+              v.size(), warm_started, iterated);
   for (std::size_t k = 1; k < v.size(); ++k) EXPECT_GT(v[k].tick, v[k - 1].tick);
 }
 
@@ -109,9 +119,9 @@ TEST(Recording, WarmReplayReproducesRecordedSolutions) {
 }
 
 // Cold: the strict hierarchy's x* is unique here (no null space left after level 4), so the
-// cold solve must find the same point; the tolerance is looser (another active-set path).
-// The paths do differ (more iterations on some levels), which shows that the warm replay above
-// really started from the recorded working sets.
+// cold solve must find the same point; the tolerance is looser (the path may differ: on the
+// deferred path the last level's dual method adds the same rows warm or cold, so the iteration
+// counts often agree).
 TEST(Recording, ColdReplayFindsTheSameSolution) {
   hqp::ProblemFileInfo info;
   const auto& v = recorded(&info);
@@ -128,7 +138,6 @@ TEST(Recording, ColdReplayFindsTheSameSolution) {
         break;
       }
   }
-  EXPECT_GT(other_path, 0);
   std::printf("cold replay: %d of %zu instances took another active-set path than the run\n", other_path,
               v.size());
 }
@@ -145,7 +154,7 @@ TEST(Recording, ColdReplayFindsTheSameSolution) {
 // level 3's working set (as stored in the file), it failed, and the general path then reported
 // Optimal at 2842; on 274 it failed in its first two orders, and the general path reported
 // Optimal at 7434. Which instances end so depends on rounding: built with -march=native, 185
-// still does (docs/benchmarks.md, "The last level on nearly dependent rows"), and this test
+// still does (docs/hqp-tuning.md, "The last level on nearly dependent rows"), and this test
 // then fails, rightly.
 const std::vector<Instance>& stressCases(hqp::ProblemFileInfo* info) {
   static hqp::ProblemFileInfo i;
@@ -196,7 +205,7 @@ TEST(Recording, IllConditionedLastLevelReachesItsOptimum) {
 }
 
 // The same instances with levels 2–4 started from the final working sets of the levels above
-// (the warm-set variants of docs/benchmarks.md): whichever point a variant ends on, the
+// (the warm-set variants of docs/hqp-tuning.md): whichever point a variant ends on, the
 // certificate must not pass it unless it is optimal. Stationarity against the gradient's own
 // terms (HqpKkt::gradient_scale) is the test; against stationarity_scale, which grows with the
 // multipliers, a wrong answer on a nearly dependent working set passes (docs/hqp.md).
