@@ -153,9 +153,9 @@ TEST(Recording, ColdReplayFindsTheSameSolution) {
 // Optimal (a row nearly dependent on the active ones was added); on 108, warm-started from
 // level 3's working set (as stored in the file), it failed, and the general path then reported
 // Optimal at 2842; on 274 it failed in its first two orders, and the general path reported
-// Optimal at 7434. Which instances end so depends on rounding: built with -march=native, 185
-// still does (docs/hqp-tuning.md, "The last level on nearly dependent rows"), and this test
-// then fails, rightly.
+// Optimal at 7434. Which instances end so depends on rounding (docs/hqp.md, "Known gaps"; at one
+// time 185 still did in -march=native builds, docs/hqp-tuning.md, "The last level on nearly
+// dependent rows"): a build whose rounding sends one there again fails this test, rightly.
 const std::vector<Instance>& stressCases(hqp::ProblemFileInfo* info) {
   static hqp::ProblemFileInfo i;
   static const std::vector<Instance> v = hqp::readProblemFile<Replay>(HQP_STRESS_CASE_FILE, &i);
