@@ -26,17 +26,10 @@ import numpy as np
 from scipy.optimize import linprog
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from hqp_oracle import bounds  # noqa: E402
+from hqp_oracle import bounds, null_space  # noqa: E402
 
-RANK_TOL = 1e-9
+RANK_TOL = 1e-9  # the multipliers' matrix rank decision (null_space()'s default is the same)
 MULT_TOL = 1e-9
-
-
-def null_space(M):
-    if M.shape[0] == 0 or M.size == 0:
-        return np.eye(M.shape[1])
-    _, s, vt = np.linalg.svd(M)
-    return vt[int((s > RANK_TOL * max(s[0], 1e-300)).sum()):].T
 
 
 def lex_point(Aw, bw, levels, DW, eW):

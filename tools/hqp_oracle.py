@@ -27,14 +27,17 @@ def bounds(values, side):
     return np.array([inf if v is None else v for v in values], dtype=float)
 
 
+def null_space(M, rank_tol=1e-9):
+    """Orthonormal basis of null(M) (columns); singular values ≤ rank_tol · the largest count as 0."""
+    if M.size == 0:  # no rows, or no columns
+        return np.eye(M.shape[1])
+    _, s, vt = np.linalg.svd(M)
+    return vt[int((s > rank_tol * max(s[0], 1e-300)).sum()):].T
+
+
 def level_optimum(A, b, w, D, lo, up, x_hat, t0, t1, c, feas_tol):
     """Lowest weighted residual of rows [t0, t1) over x_hat + null(A[:t0]) within rows [0, c)."""
-    if t0 == 0:
-        N = np.eye(A.shape[1])
-    else:
-        _, s, vt = np.linalg.svd(A[:t0])
-        rank = int((s > 1e-9 * s[0]).sum())
-        N = vt[rank:].T
+    N = null_space(A[:t0])
     sw = np.sqrt(w[t0:t1])
     Ap, bp = A[t0:t1] * sw[:, None], b[t0:t1] * sw
     M = Ap @ N
