@@ -1294,11 +1294,15 @@ template <int MaxN, int MaxRows, int MaxEq, int MaxIneq>
 QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::solveImpl(const VectorX* x_init,
                                                                bool warm_start) noexcept {
   const bool warm = warm_start && have_ws_;
+  const bool hinted = start_count_ > 0;  // setStartRows(); solveOnce() clears it
   solveOnce(x_init, warm_start);
-  // A warm start that runs into the iteration cap (a previous working set that leads the
-  // method astray, e.g. through a long degenerate stretch) falls back to one cold solve with
+  // A warm start or start rows that run into the iteration cap (a previous working set that
+  // leads the method astray, e.g. through a long degenerate stretch), or that end on a vertex
+  // failing the final check (a degenerate vertex held by other rows than the plain path
+  // picks, where an inactive row is violated by rounding), fall back to one cold solve with
   // its own budget: the worst case is 2 · max_iterations.
-  if (warm && status_ == QpStatus::IterationLimit) {
+  if ((warm || hinted) &&
+      (status_ == QpStatus::IterationLimit || status_ == QpStatus::NumericalFailure)) {
     const int spent = iterations_;
     solveOnce(x_init, false);
     iterations_ += spent;

@@ -13,10 +13,10 @@
 
 namespace {
 
-// One solver shape for the whole file (the recorded problem's is the largest), the problems
+// One solver shape for the whole file (the recorded problems' are the largest), the problems
 // sized at run time within it: each distinct shape is a whole instantiation of the solver
 // (docs/development.md, "Build and CI cost").
-using Qp = hqp::ActiveSetQp<9, 15, 5, 30>;
+using Qp = hqp::ActiveSetQp<12, 15, 5, 30>;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 std::string str(hqp::QpStatus s) { return hqp::toString(s); }
@@ -34,6 +34,28 @@ double violation(const Qp& qp) {
     if (std::isfinite(qp.upper()(j))) v = std::max(v, (cx - qp.upper()(j)) / nrm);
   }
   return v;
+}
+
+// A recorded QP (tests/data/qp_*.txt): '#' comment lines, then n m me mi, A (m x n), b,
+// C (mi x n), lower, upper; the stream is left after it.
+void readQp(std::ifstream& in, Qp& qp) {
+  std::string line;
+  while (in.peek() == '#') std::getline(in, line);
+  int n = 0, m = 0, me = 0, mi = 0;
+  in >> n >> m >> me >> mi;
+  qp.resize(n, m, me, mi);
+  const auto number = [&in] {
+    std::string t;
+    in >> t;
+    return std::stod(t);  // also "inf", "-inf"
+  };
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < n; ++j) qp.A()(i, j) = number();
+  for (int i = 0; i < m; ++i) qp.b()(i) = number();
+  for (int i = 0; i < mi; ++i)
+    for (int j = 0; j < n; ++j) qp.C()(i, j) = number();
+  for (int i = 0; i < mi; ++i) qp.lower()(i) = number();
+  for (int i = 0; i < mi; ++i) qp.upper()(i) = number();
 }
 
 hqp::testing::BruteForceResult reference(const Qp& qp) {
@@ -137,28 +159,13 @@ TEST(QpHard, WedgeOfNearlyOppositeRowsKeepsItsLargeMultipliers) {
 TEST(QpHard, NumericallyDependentVertexIsNotCalledOptimalAboveTheOptimum) {
   std::ifstream in(HQP_NEARLY_DEPENDENT_QP_FILE);
   ASSERT_TRUE(in.good()) << HQP_NEARLY_DEPENDENT_QP_FILE;
-  std::string line;
-  while (in.peek() == '#') std::getline(in, line);
-  int n = 0, m = 0, me = 0, mi = 0;
-  in >> n >> m >> me >> mi;
-  ASSERT_EQ(n, 9);
-  ASSERT_EQ(m, 15);
-  ASSERT_EQ(me, 0);
-  ASSERT_EQ(mi, 30);
   Qp qp;
-  qp.resize(n, m, me, mi);
-  const auto number = [&in] {
-    std::string t;
-    in >> t;
-    return std::stod(t);  // also "inf", "-inf"
-  };
-  for (int i = 0; i < m; ++i)
-    for (int j = 0; j < n; ++j) qp.A()(i, j) = number();
-  for (int i = 0; i < m; ++i) qp.b()(i) = number();
-  for (int i = 0; i < mi; ++i)
-    for (int j = 0; j < n; ++j) qp.C()(i, j) = number();
-  for (int i = 0; i < mi; ++i) qp.lower()(i) = number();
-  for (int i = 0; i < mi; ++i) qp.upper()(i) = number();
+  readQp(in, qp);
+  const int n = qp.variables(), mi = static_cast<int>(qp.C().rows());
+  ASSERT_EQ(n, 9);
+  ASSERT_EQ(qp.A().rows(), 15);
+  ASSERT_EQ(qp.E().rows(), 0);
+  ASSERT_EQ(mi, 30);
   ASSERT_TRUE(in.good());
   constexpr double kOptimum = 823.0864727;
   for (int hint = 0; hint < 2; ++hint) {
@@ -176,6 +183,56 @@ TEST(QpHard, NumericallyDependentVertexIsNotCalledOptimalAboveTheOptimum) {
     else
       EXPECT_EQ(str(s), "NumericalFailure");
   }
+}
+
+// A level QP of HqpWbc from the fuzz_hqp scene: from the start rows HqpWbc passes (the rows
+// the level above ended on at their bounds, x_init = 0) the solve reached a degenerate vertex
+// whose inactive row 0 was violated by 3.4e-9 and ended NumericalFailure, where the same QP
+// without them is Optimal (tests/data/qp_start_rows_vertex.txt). A hinted solve that fails so
+// must fall back to a cold one: Optimal, with a KKT certificate checked here.
+TEST(QpHard, StartRowsEndingOnAViolatedVertexFallBackToAColdSolve) {
+  std::ifstream in(HQP_START_ROWS_QP_FILE);
+  ASSERT_TRUE(in.good()) << HQP_START_ROWS_QP_FILE;
+  Qp qp;
+  readQp(in, qp);
+  int count = 0;
+  in >> count;
+  ASSERT_EQ(count, 20);
+  int rows[20];
+  bool upper[20];
+  for (int k = 0; k < count; ++k) {
+    int up = 0;
+    in >> rows[k] >> up;
+    upper[k] = up != 0;
+  }
+  ASSERT_TRUE(in.good());
+  const int n = qp.variables();
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+  qp.resetWorkingSet();
+  ASSERT_EQ(str(qp.solve(zero, false)), "Optimal");  // without the start rows
+  const double plain = qp.objective();
+  qp.resetWorkingSet();
+  qp.setStartRows(count, rows, upper);
+  ASSERT_EQ(str(qp.solve(zero, false)), "Optimal");
+  EXPECT_NEAR(qp.objective(), plain, 1e-12 * plain);
+  // KKT, from the returned x and multipliers alone: x feasible, μ ≥ 0, active rows at their
+  // bounds, and Aᵀ(Ax − b) + Σ ±μ c = 0 to the rounding of its terms.
+  EXPECT_LE(violation(qp), 1e-9);
+  const Eigen::VectorXd x = qp.x();
+  const Eigen::VectorXd g = qp.A().transpose() * (qp.A() * x - qp.b());
+  Eigen::VectorXd stat = g;
+  double scale = qp.A().norm() * (qp.A() * x - qp.b()).norm();
+  for (int k = 0; k < qp.numActive(); ++k) {
+    const int j = qp.activeRow(k);
+    const double mu = qp.multiplier(k);
+    const Eigen::VectorXd c = qp.C().row(j).transpose();
+    EXPECT_GE(mu, 0.0) << "row " << j;
+    const double bound = qp.activeAtUpper(k) ? qp.upper()(j) : qp.lower()(j);
+    EXPECT_LE(std::abs(c.dot(x) - bound), 1e-9 * (1.0 + std::abs(bound)) * c.norm()) << "row " << j;
+    stat += (qp.activeAtUpper(k) ? mu : -mu) * c;
+    scale += mu * c.norm();
+  }
+  EXPECT_LE(stat.norm(), 1e-9 * scale) << "stationarity";
 }
 
 TEST(QpHard, RedundantConsistentEqualities) {
