@@ -155,10 +155,11 @@ class ActiveSetQp {
     have_ws_ = true;
   }
   // Rows believed to hold at their bounds at the x_init of the next solve (e.g. the rows active
-  // at the point a cascade's level starts from). Used by that solve only, and only if it
-  // starts phase 2 at x_init (no warm working set kept): the rows that hold at x_init to the
-  // feasibility tolerance form its first working set (dependent ones are left out), where
-  // without them it starts with none and re-adds each as a blocking row, one iteration apiece.
+  // at the point a cascade's level starts from). Used by that solve only (which drops them
+  // also where it stops early, e.g. on invalid input), and only if it starts phase 2 at x_init
+  // (no warm working set kept): the rows that hold at x_init to the feasibility tolerance form
+  // its first working set (dependent ones are left out), where without them it starts with
+  // none and re-adds each as a blocking row, one iteration apiece.
   void setStartRows(int count, const int* rows, const bool* upper) {
     start_count_ = copyRows(count, rows, upper, start_row_, start_upper_);
   }
@@ -1316,6 +1317,9 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::solveOnce(const VectorX* x_
   iterations_ = 0;
   xs_fresh_ = false;
   cx_at_xc_ = false;
+  // setStartRows() is for this solve only, also if it stops before using them.
+  const int start_count = start_count_;
+  start_count_ = 0;
   for (int i = 0; i < me_; ++i) lam_eq_(i) = 0.0;
   const bool warm = warm_start && have_ws_;
   cold_ = !warm;
@@ -1369,8 +1373,6 @@ QpStatus ActiveSetQp<MaxN, MaxRows, MaxEq, MaxIneq>::solveOnce(const VectorX* x_
       addEqualities();
     }
   }
-  const int start_count = start_count_;
-  start_count_ = 0;
   if (!started && x_init != nullptr && x_init->size() == n_) {
     for (int i = 0; i < n_; ++i) xc_(i) = (*x_init)(i);
     started = xc_.head(n_).allFinite() && maxViolation(xc_) <= settings_.feasibility_tol;

@@ -2,6 +2,7 @@
 // must agree (the warm start only changes the path, not the answer).
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -153,6 +154,56 @@ TEST(QpWarm, StartRowsAtAFeasibleHintGiveTheColdAnswerInFewerIterations) {
   ASSERT_GT(tried, 5);
   // Without them every active row is re-added as a blocking row, one iteration each.
   EXPECT_LT(with_rows, without_rows / 2) << with_rows << " vs " << without_rows;
+}
+
+// setStartRows() is for the next solve only, also when that solve stops before its first
+// working set (crossed bounds, invalid input): the solve after it is a plain one. Expectations
+// from a solver that never had start rows.
+TEST(QpWarm, StartRowsAreDroppedBySolvesThatStopEarly) {
+  std::mt19937 rng(34);
+  Qp start, plain, cold;
+  start.settings().max_iterations = plain.settings().max_iterations =
+      cold.settings().max_iterations = 500;
+  int tried = 0;
+  for (int k = 0; k < 20; ++k) {
+    const auto p = hqp::testing::makeRandomQp(rng, 30, 15, 6, 48, -1, 0.5);
+    hqp::testing::loadInto(cold, p);
+    ASSERT_EQ(cold.solve(false), hqp::QpStatus::Optimal) << k;
+    if (cold.numActive() < 3) continue;
+    std::vector<int> act;
+    bool act_up[64];
+    for (int a = 0; a < cold.numActive(); ++a) {
+      act.push_back(cold.activeRow(a));
+      act_up[a] = cold.activeAtUpper(a);
+    }
+    const Qp::VectorX xstar = cold.x();
+    const int cnt = static_cast<int>(act.size());
+    hqp::testing::loadInto(plain, p);
+    ASSERT_EQ(plain.solve(xstar, false), hqp::QpStatus::Optimal) << k;
+    // The start rows matter here: with them the solve takes fewer iterations.
+    hqp::testing::loadInto(start, p);
+    start.setStartRows(cnt, act.data(), act_up);
+    ASSERT_EQ(start.solve(xstar, false), hqp::QpStatus::Optimal) << k;
+    ASSERT_LT(start.iterations(), plain.iterations()) << k;
+    for (int early = 0; early < 2; ++early) {
+      hqp::testing::loadInto(start, p);
+      start.setStartRows(cnt, act.data(), act_up);
+      if (early == 0) {
+        start.lower()(0) = 1.0;  // an empty interval
+        start.upper()(0) = 0.0;
+        EXPECT_EQ(start.solve(xstar, false), hqp::QpStatus::Infeasible) << k;
+      } else {
+        start.A()(0, 0) = std::numeric_limits<double>::quiet_NaN();
+        EXPECT_EQ(start.solve(xstar, false), hqp::QpStatus::InvalidInput) << k;
+      }
+      hqp::testing::loadInto(start, p);
+      ASSERT_EQ(start.solve(xstar, false), hqp::QpStatus::Optimal) << k << " " << early;
+      EXPECT_EQ(start.iterations(), plain.iterations()) << k << " " << early;
+      EXPECT_LE((start.x() - plain.x()).cwiseAbs().maxCoeff(), 1e-12) << k << " " << early;
+    }
+    ++tried;
+  }
+  ASSERT_GT(tried, 5);
 }
 
 }  // namespace
