@@ -13,6 +13,21 @@ namespace {
 
 using Qp = hqp::ActiveSetQp<30, 15, 6, 48>;
 
+// A solve's working set (rows and sides), in the form setStartRows() takes.
+struct ActiveRows {
+  std::vector<int> row;
+  bool upper[64] = {};
+  int count() const { return static_cast<int>(row.size()); }
+};
+ActiveRows activeRowsOf(const Qp& qp) {
+  ActiveRows a;
+  for (int k = 0; k < qp.numActive(); ++k) {
+    a.row.push_back(qp.activeRow(k));
+    a.upper[k] = qp.activeAtUpper(k);
+  }
+  return a;
+}
+
 TEST(QpWarm, PerturbedSequencesMatchColdStarts) {
   std::mt19937 rng(99);
   std::normal_distribution<double> N(0.0, 1.0);
@@ -135,14 +150,9 @@ TEST(QpWarm, StartRowsAtAFeasibleHintGiveTheColdAnswerInFewerIterations) {
     EXPECT_EQ(start.iterations(), plain.iterations()) << k;
     // From the cold optimum with its active set as start rows: nothing left to change.
     if (cold.numActive() >= 3) {
-      std::vector<int> act;
-      bool act_up[64];
-      for (int a = 0; a < cold.numActive(); ++a) {
-        act.push_back(cold.activeRow(a));
-        act_up[a] = cold.activeAtUpper(a);
-      }
+      const ActiveRows act = activeRowsOf(cold);
       const Qp::VectorX xstar = cold.x();
-      start.setStartRows(static_cast<int>(act.size()), act.data(), act_up);
+      start.setStartRows(act.count(), act.row.data(), act.upper);
       ASSERT_EQ(start.solve(xstar, false), hqp::QpStatus::Optimal) << k;
       ASSERT_EQ(plain.solve(xstar, false), hqp::QpStatus::Optimal) << k;
       EXPECT_NEAR(start.objective(), cold.objective(), 1e-9 * (1.0 + cold.objective())) << k;
@@ -170,24 +180,18 @@ TEST(QpWarm, StartRowsAreDroppedBySolvesThatStopEarly) {
     hqp::testing::loadInto(cold, p);
     ASSERT_EQ(cold.solve(false), hqp::QpStatus::Optimal) << k;
     if (cold.numActive() < 3) continue;
-    std::vector<int> act;
-    bool act_up[64];
-    for (int a = 0; a < cold.numActive(); ++a) {
-      act.push_back(cold.activeRow(a));
-      act_up[a] = cold.activeAtUpper(a);
-    }
+    const ActiveRows act = activeRowsOf(cold);
     const Qp::VectorX xstar = cold.x();
-    const int cnt = static_cast<int>(act.size());
     hqp::testing::loadInto(plain, p);
     ASSERT_EQ(plain.solve(xstar, false), hqp::QpStatus::Optimal) << k;
     // The start rows matter here: with them the solve takes fewer iterations.
     hqp::testing::loadInto(start, p);
-    start.setStartRows(cnt, act.data(), act_up);
+    start.setStartRows(act.count(), act.row.data(), act.upper);
     ASSERT_EQ(start.solve(xstar, false), hqp::QpStatus::Optimal) << k;
     ASSERT_LT(start.iterations(), plain.iterations()) << k;
     for (int early = 0; early < 2; ++early) {
       hqp::testing::loadInto(start, p);
-      start.setStartRows(cnt, act.data(), act_up);
+      start.setStartRows(act.count(), act.row.data(), act.upper);
       if (early == 0) {
         start.lower()(0) = 1.0;  // an empty interval
         start.upper()(0) = 0.0;
