@@ -1,14 +1,17 @@
 #pragma once
 // A periodic real-time loop as it runs on a robot PC: mlockall, a prefaulted stack,
-// SCHED_FIFO, CPU affinity, absolute clock_nanosleep on CLOCK_MONOTONIC, an overrun counter,
-// and per-tick wake-up latency and compute time in a ring buffer preallocated before start.
+// SCHED_FIFO, CPU affinity, a CPU-idle latency request, absolute clock_nanosleep on
+// CLOCK_MONOTONIC, an overrun counter, and per-tick wake-up latency and compute time in a ring
+// buffer preallocated before start.
 // Where the process lacks the privileges (no CAP_SYS_NICE / RLIMIT_RTPRIO, RLIMIT_MEMLOCK),
 // start() says which step failed and the loop runs anyway; the figures are then not RT.
 
+#include <fcntl.h>
 #include <pthread.h>
 #include <sched.h>
 #include <sys/mman.h>
 #include <time.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -27,14 +30,26 @@ struct RtOptions {
   int cpu = -1;                   // pin to this CPU; −1: no affinity
   bool lock_memory = true;        // mlockall(MCL_CURRENT | MCL_FUTURE)
   std::size_t stack_prefault = 256 * 1024;  // bytes of stack touched before start
+  // A PM QoS request on /dev/cpu_dma_latency, held while the process lives (cyclictest makes the
+  // same one): no CPU enters an idle state that takes longer than this to leave. The loop's CPU
+  // idles between ticks; without the request its wake-up and tick were slower on an idle
+  // machine (docs/realtime.md, "Measured jitter"). -1: no request.
+  int cpu_dma_latency_us = 0;
 };
 
 struct RtState {
   bool memory_locked = false;
   bool fifo = false;
   bool pinned = false;
+  int latency_fd = -1;  // open while the cpu_dma_latency request holds
   bool realTime() const { return memory_locked && fifo; }
 };
+
+// Ends the cpu_dma_latency request (closing its file ends it; so does the process's exit).
+inline void releaseCpuLatency(RtState& st) {
+  if (st.latency_fd >= 0) close(st.latency_fd);
+  st.latency_fd = -1;
+}
 
 // Touches `bytes` of stack so that the tick never page-faults on it (with mlockall, the
 // pages stay resident).
@@ -55,6 +70,17 @@ inline RtState startRealTime(const RtOptions& o) {
                       std::strerror(errno));
   }
   prefaultStack(o.stack_prefault);
+  if (o.cpu_dma_latency_us >= 0) {
+    const int fd = open("/dev/cpu_dma_latency", O_WRONLY | O_CLOEXEC);
+    const std::int32_t us = o.cpu_dma_latency_us;
+    if (fd >= 0 && write(fd, &us, sizeof us) == static_cast<ssize_t>(sizeof us)) {
+      st.latency_fd = fd;
+    } else {
+      std::fprintf(stderr, "rt: no cpu_dma_latency request of %d us (%s): idle CPUs may wake slowly\n", us,
+                   std::strerror(errno));
+      if (fd >= 0) close(fd);
+    }
+  }
   if (o.cpu >= 0) {
     cpu_set_t set;
     CPU_ZERO(&set);

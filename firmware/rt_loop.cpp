@@ -121,6 +121,9 @@ int main(int argc, char** argv) {
   app.add_option("--priority", rt.priority, "SCHED_FIFO priority (0: SCHED_OTHER)")->check(CLI::Range(0, 99));
   app.add_option("--cpu", rt.cpu, "pin the loop to this CPU (-1: no affinity)")->check(CLI::Range(-1, 1023));
   app.add_flag("--no-mlock", no_mlock, "skip mlockall");
+  app.add_option("--cpu-dma-latency", rt.cpu_dma_latency_us,
+                 "hold a /dev/cpu_dma_latency request of this many us while running (-1: none)")
+      ->check(CLI::Range(-1, 2000000000));
   app.add_option("--ring", ring, "tick samples kept (ring buffer, allocated before start)")->check(CLI::PositiveNumber);
   app.add_option("--out", out_dir, "write rt_ticks.csv and rt_summary.txt here");
   app.add_option("--budget-us", budget_us, "override qp.hqp.budget_us (0: none)")->check(CLI::NonNegativeNumber);
@@ -234,9 +237,10 @@ int main(int argc, char** argv) {
       std::snprintf(buf, sizeof buf, fmt, a...);
       summary += buf;
     };
-    add("rt_loop: backend %s, %s: SCHED_FIFO %s (priority %d), mlockall %s, CPU %s\n", backend.c_str(),
-        is_rt ? "REAL TIME" : "NOT RT", rts.fifo ? "yes" : "no", rt.priority, rts.memory_locked ? "yes" : "no",
-        rts.pinned ? std::to_string(rt.cpu).c_str() : "any");
+    add("rt_loop: backend %s, %s: SCHED_FIFO %s (priority %d), mlockall %s, CPU %s, cpu_dma_latency %s\n",
+        backend.c_str(), is_rt ? "REAL TIME" : "NOT RT", rts.fifo ? "yes" : "no", rt.priority,
+        rts.memory_locked ? "yes" : "no", rts.pinned ? std::to_string(rt.cpu).c_str() : "any",
+        rts.latency_fd >= 0 ? (std::to_string(rt.cpu_dma_latency_us) + " us").c_str() : "none");
     add("ticks: %ld  overruns: %ld  safe-mode ticks: %ld (first reason %d)  budget-cut ticks: %ld  "
         "max QP iterations per tick: %d  allocations after start: %ld\n",
         loop.ticks(), loop.overruns(), safe_ticks, first_safe_reason, cut_ticks, max_iterations, allocations);

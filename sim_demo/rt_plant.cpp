@@ -43,6 +43,7 @@ int main(int argc, char** argv) {
   sim.reset();
   fw::installStopHandler();  // SIGINT: finish, write the log, remove the image
   rt.lock_memory = rt.priority > 0;
+  rt.cpu_dma_latency_us = rt.priority > 0 ? 0 : -1;
   fw::startRealTime(rt);  // the same start-up as the loop; failures are reported, not fatal
 
   shm_unlink(shm_name.c_str());  // a stale image of an earlier run
