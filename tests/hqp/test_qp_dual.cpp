@@ -14,6 +14,7 @@
 #include "hqp/dual_active_set_qp.hpp"
 #include "support/allocation_counter.hpp"
 #include "support/brute_force_qp.hpp"
+#include "support/kkt_error.hpp"
 
 namespace {
 
@@ -27,34 +28,11 @@ hqp::QpStatus solve(Qp& qp, const hqp::testing::RandomQp& p) {
   return qp.solve(p.C, p.lower, p.upper, static_cast<int>(p.C.rows()), hqp::QpSettings{});
 }
 
-// Largest scaled KKT residual: stationarity Aᵀ(Ax − b) + Σ ±μ c = 0, primal feasibility per
-// unit row, dual feasibility μ ≥ 0 and complementarity μ · slack = 0 on the reported rows.
+// Largest scaled KKT residual (tests/support/kkt_error.hpp): stationarity, primal
+// feasibility per unit row, dual feasibility μ ≥ 0 and complementarity μ · slack = 0.
 template <class Qp>
 double kktError(const Qp& qp, const hqp::testing::RandomQp& p) {
-  const Eigen::VectorXd x = qp.x();
-  const Eigen::VectorXd g = p.A.transpose() * (p.A * x - p.b);
-  Eigen::VectorXd s = g;
-  double scale = 1.0 + g.cwiseAbs().maxCoeff();
-  double err = 0.0;
-  for (int a = 0; a < qp.numActive(); ++a) {
-    const int j = qp.activeRow(a);
-    const double mu = qp.multiplier(a);
-    const Eigen::VectorXd t = (qp.activeAtUpper(a) ? mu : -mu) * p.C.row(j).transpose();
-    s += t;
-    scale = std::max(scale, t.cwiseAbs().maxCoeff());
-    err = std::max(err, -mu);
-    const double bound = qp.activeAtUpper(a) ? p.upper(j) : p.lower(j);
-    err = std::max(err, std::abs(mu) * std::abs(p.C.row(j).dot(x) - bound));
-  }
-  err /= scale;
-  err = std::max(err, s.cwiseAbs().maxCoeff() / scale);
-  const Eigen::VectorXd cx = p.C * x;
-  for (int j = 0; j < cx.size(); ++j) {
-    const double nrm = std::max(p.C.row(j).norm(), 1e-300);
-    if (std::isfinite(p.lower(j))) err = std::max(err, (p.lower(j) - cx(j)) / nrm);
-    if (std::isfinite(p.upper(j))) err = std::max(err, (cx(j) - p.upper(j)) / nrm);
-  }
-  return err;
+  return hqp::testing::kkt(qp, p).largest();
 }
 
 // A Farkas certificate checked here from the problem's data: weights y ≥ 0 on rows written
