@@ -73,13 +73,13 @@ def quantiles_of_histogram(us, counts, info):
 
 
 def table(loops, cyclic):
+    """loops: (label, read_ticks(...)); cyclic: (label, read_cyclictest(...))."""
     print("| source | samples | min | mean | p99 | p99.9 | max |")
     print("|---|---|---|---|---|---|---|")
-    for label, path in cyclic:
-        mn, mean, p99, p999, mx, n = quantiles_of_histogram(*read_cyclictest(path))
+    for label, hist in cyclic:
+        mn, mean, p99, p999, mx, n = quantiles_of_histogram(*hist)
         print(f"| cyclictest, {label} | {n} | {mn} | {mean:.0f} | {p99} | {p999} | {mx} |")
-    for label, path in loops:
-        wake, compute, rt = read_ticks(path)
+    for label, (wake, compute, rt) in loops:
         tag = "" if rt else " (NOT RT)"
         for what, v in (("wake-up", wake), ("compute", compute)):
             mn, mean, p99, p999, mx, n = quantiles_of_samples(v)
@@ -97,24 +97,24 @@ def main(argv):
             continue
         label, path = a.split("=", 1)
         (target if target is not None else loops).append((label, path))
+    # Each file read once (a 60 000-tick log is a few MB).
+    loops = [(label, read_ticks(path)) for label, path in loops]
+    cyclic = [(label, read_cyclictest(path)) for label, path in cyclic]
     table(loops, cyclic)
     fig, (ax_w, ax_c) = plt.subplots(1, 2, figsize=(12, 4.5))
     # Log-spaced bins for both panels: on a shared VM the tails (vCPU stalls) span three to four
     # decades, which linear bins would squeeze the body of the distribution into one bin beside.
     top = 1.0
-    for label, path in loops:
-        wake, compute, _ = read_ticks(path)
+    for label, (wake, compute, _) in loops:
         top = max(top, max(wake), max(compute))
-    for label, path in cyclic:
-        top = max(top, float(read_cyclictest(path)[2]["Max Latencies"]))
+    for label, (_, _, info) in cyclic:
+        top = max(top, float(info["Max Latencies"]))
     edges = [10 ** (k / 40.0) for k in range(0, int(40 * math.log10(top)) + 2)]
-    for label, path in loops:
-        wake, compute, rt = read_ticks(path)
+    for label, (wake, compute, rt) in loops:
         tag = "" if rt else " (NOT RT)"
         ax_w.hist(wake, bins=edges, histtype="step", log=True, label=f"rt_loop {label}{tag}")
         ax_c.hist(compute, bins=edges, histtype="step", log=True, label=f"{label}{tag}")
-    for label, path in cyclic:
-        us, counts, _ = read_cyclictest(path)  # 1 µs bins, regrouped into the same edges
+    for label, (us, counts, _) in cyclic:  # 1 µs bins, regrouped into the same edges
         regrouped = [0] * (len(edges) - 1)
         for u, c in zip(us, counts):
             for k in range(len(edges) - 1):
